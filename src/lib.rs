@@ -1,0 +1,11 @@
+//! peopletrack: offline people-tracking analytics over MCAP session logs.
+//!
+//! Data flows one way: a log ([`log`]) is decoded into sensor frames, stages turn frames into
+//! detections and tracks, and evaluation turns tracks into tables and figures. See
+//! `ARCHITECTURE.md` for the map.
+
+pub mod cli;
+pub mod log;
+pub mod time;
+
+pub use time::Nanos;

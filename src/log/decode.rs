@@ -1,0 +1,171 @@
+//! Which decoder reads which channel, decided once per channel from its message and schema
+//! encodings (the "plan" step of `inspect` and `run --dry-run`), then applied per message:
+//!
+//! | message encoding | schema encoding | decoder |
+//! |---|---|---|
+//! | `cdr` | `ros2msg` | [`super::cdr`] with the parsed [`Registry`] |
+//! | `protobuf` | `protobuf` | [`super::protobuf`] with the embedded `FileDescriptorSet` |
+//! | `json` | `jsonschema` or none | `serde_json` |
+//!
+//! Typed reads ([`Decoders::typed`]) check that the channel carries the requested type (by ROS
+//! 2 name, or by one of its Foxglove equivalents) before converting.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use prost_reflect::MessageDescriptor;
+
+use super::cdr;
+use super::error::{LogError, LogErrorKind};
+use super::msgs::RosMessage;
+use super::protobuf::{self, FoxgloveMessage};
+use super::reader::{ChannelInfo, Message, SessionLog};
+use super::ros2msg::{Registry, normalize_type_name};
+use super::value::Value;
+use crate::time::Nanos;
+
+/// How one channel's messages are decoded.
+#[derive(Debug, Clone)]
+pub enum Decoder {
+    Cdr(Arc<Registry>),
+    Protobuf(MessageDescriptor),
+    Json,
+}
+
+impl Decoder {
+    /// Choose and prepare the decoder for a channel (parses its schema once).
+    pub fn for_channel(ch: &ChannelInfo) -> Result<Decoder, LogErrorKind> {
+        let schema_encoding = ch.schema.as_deref().map_or("", |s| s.encoding.as_str());
+        match (ch.message_encoding.as_str(), schema_encoding) {
+            ("cdr", "ros2msg") => {
+                let schema = ch.schema.as_deref().expect("ros2msg implies a schema");
+                let text = String::from_utf8_lossy(&schema.data);
+                let reg = Registry::parse(&schema.name, &text).map_err(|source| {
+                    LogErrorKind::Schema {
+                        schema: schema.name.clone(),
+                        source,
+                    }
+                })?;
+                Ok(Decoder::Cdr(Arc::new(reg)))
+            }
+            ("protobuf", "protobuf") => {
+                let schema = ch.schema.as_deref().expect("protobuf implies a schema");
+                protobuf::descriptor(&schema.name, &schema.data)
+                    .map(Decoder::Protobuf)
+                    .map_err(LogErrorKind::Protobuf)
+            }
+            ("json", "jsonschema" | "") => Ok(Decoder::Json),
+            (m, s) => Err(LogErrorKind::UnsupportedEncoding {
+                message_encoding: m.to_string(),
+                schema_encoding: s.to_string(),
+            }),
+        }
+    }
+
+    /// Decode one payload into a value tree.
+    pub fn decode(&self, data: &[u8]) -> Result<Value, LogErrorKind> {
+        match self {
+            Decoder::Cdr(reg) => Ok(cdr::decode(reg, data)?),
+            Decoder::Protobuf(desc) => protobuf::decode(desc, data).map_err(LogErrorKind::Protobuf),
+            Decoder::Json => serde_json::from_slice::<serde_json::Value>(data)
+                .map(|j| Value::from_json(&j))
+                .map_err(|e| LogErrorKind::Json(e.to_string())),
+        }
+    }
+
+    /// A short description for `inspect`.
+    pub fn describe(&self) -> &'static str {
+        match self {
+            Decoder::Cdr(_) => "ROS 2 CDR (dynamic)",
+            Decoder::Protobuf(_) => "protobuf (dynamic)",
+            Decoder::Json => "JSON",
+        }
+    }
+}
+
+/// True if a channel's schema names the ROS 2 type `type_name` (`pkg/Type` or `pkg/msg/Type`).
+pub fn carries(ch: &ChannelInfo, type_name: &str) -> bool {
+    normalize_type_name(ch.schema_name()).is_some_and(|n| n == type_name)
+}
+
+/// Decoders per channel, built on first use. One per reading thread.
+#[derive(Debug, Default)]
+pub struct Decoders {
+    by_channel: HashMap<u16, Result<Decoder, String>>,
+}
+
+impl Decoders {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    fn decoder(&mut self, log: &SessionLog, msg: &Message) -> Result<&Decoder, LogError> {
+        let ch = &msg.channel;
+        let entry = self
+            .by_channel
+            .entry(ch.id)
+            .or_insert_with(|| Decoder::for_channel(ch).map_err(|e| e.to_string()));
+        entry.as_ref().map_err(|reason| {
+            // the parse error is stored as text so it can be reported for every message
+            let kind = Decoder::for_channel(ch)
+                .err()
+                .unwrap_or(LogErrorKind::Protobuf(reason.clone()));
+            LogError::new(log.path(), kind)
+                .on_topic(&ch.topic)
+                .at(msg.log_time)
+        })
+    }
+
+    /// Decode a message into a value tree; errors name file, topic and log time.
+    pub fn value(&mut self, log: &SessionLog, msg: &Message) -> Result<Value, LogError> {
+        let dec = self.decoder(log, msg)?;
+        dec.decode(&msg.data).map_err(|k| {
+            LogError::new(log.path(), k)
+                .on_topic(msg.topic())
+                .at(msg.log_time)
+        })
+    }
+
+    /// Decode a message as the typed `T`, from its ROS 2 type or a Foxglove equivalent.
+    pub fn typed<T: RosMessage + FoxgloveMessage>(
+        &mut self,
+        log: &SessionLog,
+        msg: &Message,
+    ) -> Result<T, LogError> {
+        let ch = Arc::clone(&msg.channel);
+        let err = |k: LogErrorKind| {
+            LogError::new(log.path(), k)
+                .on_topic(&ch.topic)
+                .at(msg.log_time)
+        };
+        let schema = ch.schema_name().to_string();
+        let is_ros = carries(&ch, T::TYPE_NAME);
+        let is_foxglove = T::FOXGLOVE_NAMES.contains(&schema.as_str());
+        if !is_ros && !is_foxglove {
+            return Err(err(LogErrorKind::WrongType {
+                expected: T::TYPE_NAME.to_string(),
+                found: schema,
+            }));
+        }
+        let v = self.value(log, msg)?;
+        let typed = if is_ros {
+            T::from_value(v)
+        } else {
+            T::from_foxglove(&schema, v)
+        };
+        typed.map_err(|e| err(e.into()))
+    }
+}
+
+/// Read every message of `topic` as `T`, in log-time order, as `(log_time, message)`.
+pub fn read_topic<T: RosMessage + FoxgloveMessage>(
+    log: &SessionLog,
+    topic: &str,
+) -> Result<impl Iterator<Item = Result<(Nanos, T), LogError>>, LogError> {
+    let mut decoders = Decoders::new();
+    let stream = log.messages_on(&[topic])?;
+    Ok(stream.map(move |m| {
+        let m = m?;
+        decoders.typed::<T>(log, &m).map(|t| (m.log_time, t))
+    }))
+}
