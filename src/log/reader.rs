@@ -469,7 +469,9 @@ impl SessionLog {
     }
 
     fn stream(&self, topics: Option<BTreeSet<String>>) -> Result<MessageStream, LogError> {
-        let file = File::open(&self.path).map_err(|e| LogError::new(&self.path, e))?;
+        let mut file = File::open(&self.path).map_err(|e| LogError::new(&self.path, e))?;
+        file.seek(SeekFrom::Start(8))
+            .map_err(|e| LogError::new(&self.path, e))?;
         let s = &self.summary;
         let mode = if s.unchunked_messages {
             Mode::Linear {
@@ -513,14 +515,15 @@ impl SessionLog {
     }
 }
 
-/// A summary is usable for indexed reading if it indexes every chunk (or the file has none)
-/// and no message lives outside a chunk.
+/// A summary is usable if it indexes the chunks, or says the messages are outside chunks (read
+/// in file order), or says there are none. Without statistics and chunk indexes it tells too
+/// little, and the index is rebuilt by a linear pass.
 fn summary_is_complete(s: &LogSummary) -> bool {
-    !s.unchunked_messages
-        && (!s.chunks.is_empty()
-            || s.statistics
-                .as_ref()
-                .is_some_and(|st| st.message_count == 0))
+    s.unchunked_messages
+        || !s.chunks.is_empty()
+        || s.statistics
+            .as_ref()
+            .is_some_and(|st| st.message_count == 0)
 }
 
 fn read_at(
@@ -813,6 +816,20 @@ fn linear_index(file: &mut File, file_len: u64) -> Result<LogSummary, LogErrorKi
         );
         if !needs_body {
             if opcode == op::FOOTER {
+                // a complete file ends with the footer and the closing magic
+                let end = pos + 9 + len;
+                let mut tail = Vec::new();
+                reader.seek_relative(len as i64)?;
+                reader.take(8).read_to_end(&mut tail)?;
+                if tail.as_slice() != MAGIC {
+                    return Err(LogErrorKind::Truncated {
+                        what: "closing magic",
+                        offset: end,
+                        needed: 8,
+                        file_len,
+                        last: last_named(&summary.channels),
+                    });
+                }
                 break;
             }
             reader.seek_relative(len as i64)?;
@@ -962,13 +979,20 @@ impl MessageStream {
     }
 
     /// Decompress a chunk body, register its schemas/channels, and index its wanted messages.
-    fn load(
-        &mut self,
-        body: &[u8],
-        chunk_offset: u64,
-        ids: Option<&BTreeSet<u16>>,
-    ) -> Result<Slot, LogErrorKind> {
-        let (_, _, _, data) = open_chunk(body, chunk_offset, &self.channels, ids)?;
+    fn load(&mut self, body: &[u8], chunk: &ChunkInfo) -> Result<Slot, LogErrorKind> {
+        let chunk_offset = chunk.offset;
+        let (start, end, _, data) =
+            open_chunk(body, chunk_offset, &self.channels, chunk.channels.as_ref())?;
+        if chunk.length > 0 && (start, end) != (chunk.start, chunk.end) {
+            return Err(LogErrorKind::BadRecord {
+                record: "chunk",
+                offset: chunk_offset,
+                reason: format!(
+                    "header time range {start}..{end} s differs from the index's {}..{} s",
+                    chunk.start, chunk.end
+                ),
+            });
+        }
         let mut entries = Vec::new();
         for rec in records(&data) {
             let (opcode, b, at) = rec.map_err(bad("chunk", chunk_offset))?;
@@ -1072,7 +1096,18 @@ impl MessageStream {
                         reason: "the chunk index points at a record that is not a chunk".into(),
                     });
                 }
-                let slot = self.load(&rec[9..], chunk.offset, chunk.channels.as_ref())?;
+                let stored_len = u64::from_le_bytes(rec[1..9].try_into().expect("8 bytes"));
+                if stored_len != chunk.length - 9 {
+                    return Err(LogErrorKind::BadRecord {
+                        record: "chunk",
+                        offset: chunk.offset,
+                        reason: format!(
+                            "record length field says {stored_len} bytes, the chunk index says {}",
+                            chunk.length - 9
+                        ),
+                    });
+                }
+                let slot = self.load(&rec[9..], &chunk)?;
                 let Mode::Indexed { slots, heap, .. } = &mut self.mode else {
                     unreachable!()
                 };
@@ -1165,7 +1200,15 @@ impl MessageStream {
                             }
                         }
                         _ => {
-                            let slot = self.load(&body[9..], record_pos, None)?;
+                            let unindexed = ChunkInfo {
+                                offset: record_pos,
+                                length: 0, // not from an index: nothing to compare with
+                                start: Nanos(0),
+                                end: Nanos(0),
+                                compression: String::new(),
+                                channels: None,
+                            };
+                            let slot = self.load(&body[9..], &unindexed)?;
                             let Mode::Linear { current, .. } = &mut self.mode else {
                                 unreachable!()
                             };
@@ -1176,6 +1219,14 @@ impl MessageStream {
                 _ => reader.seek_relative(len as i64)?,
             }
         }
+    }
+}
+
+impl std::fmt::Debug for MessageStream {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MessageStream")
+            .field("path", &self.path)
+            .finish_non_exhaustive()
     }
 }
 
