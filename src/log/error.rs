@@ -97,7 +97,8 @@ pub struct LogError {
     pub path: PathBuf,
     pub topic: Option<String>,
     pub log_time: Option<Nanos>,
-    pub kind: LogErrorKind,
+    /// Boxed so `Result<_, LogError>` stays small on the hot path.
+    pub kind: Box<LogErrorKind>,
 }
 
 impl LogError {
@@ -106,7 +107,7 @@ impl LogError {
             path: path.into(),
             topic: None,
             log_time: None,
-            kind: kind.into(),
+            kind: Box::new(kind.into()),
         }
     }
 

@@ -710,6 +710,15 @@ fn open_chunk(
     };
     let data = match h.compression.as_str() {
         "" => h.records.to_vec(),
+        // Sizes up to 256 MiB are trusted enough to allocate up front and decompress in one
+        // call; larger claims stream, so a corrupt size cannot reserve gigabytes.
+        "zstd" if want <= 1 << 28 => {
+            let mut out = Vec::with_capacity(want as usize);
+            zstd::bulk::Decompressor::new()
+                .and_then(|mut d| d.decompress_to_buffer(h.records, &mut out))
+                .map_err(|e| fail(e.to_string()))?;
+            out
+        }
         "zstd" => {
             let mut out = Vec::new();
             zstd::stream::read::Decoder::new(h.records)

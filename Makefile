@@ -1,0 +1,34 @@
+# peopletrack — the README's commands. `make help` lists the targets.
+CARGO ?= cargo
+PYTHON ?= python3
+VENV := target/py-venv
+
+.PHONY: help test bench interop clean
+
+help:
+	@echo "make test      build and run every test (the CI command)"
+	@echo "make bench     criterion benchmarks + the same reads in Python mcap-ros2-support, with ratios"
+	@echo "make interop   check that Python mcap-ros2-support opens what we write (throwaway venv)"
+	@echo "make clean     remove build outputs and out/"
+
+test:
+	$(CARGO) test --locked
+
+# A throwaway virtual environment with the Python peers (not needed by the project itself).
+$(VENV)/ok:
+	$(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check mcap==1.6.0 mcap-ros2-support==0.6.0
+	touch $@
+
+interop: $(VENV)/ok
+	$(CARGO) run --quiet --release --example interop_fixture -- target/interop/fixture.mcap target/interop/expected.json
+	$(VENV)/bin/python tools/check_mcap_ros2.py target/interop/fixture.mcap target/interop/expected.json
+
+bench: $(VENV)/ok
+	$(CARGO) bench --bench read_decode -- --noplot
+	$(VENV)/bin/python tools/bench_python_read.py target/bench-data/python_read.json
+	$(VENV)/bin/python tools/bench_compare.py target/criterion target/bench-data/python_read.json
+
+clean:
+	$(CARGO) clean
+	rm -rf out
