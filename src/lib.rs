@@ -5,6 +5,7 @@
 //! `ARCHITECTURE.md` for the map.
 
 pub mod cli;
+pub mod eval;
 pub mod log;
 pub mod time;
 

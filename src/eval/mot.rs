@@ -1,0 +1,1 @@
+//! Tracking metrics (being written).
