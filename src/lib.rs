@@ -7,6 +7,7 @@
 pub mod cli;
 pub mod eval;
 pub mod log;
+pub mod report;
 pub mod time;
 
 pub use time::Nanos;

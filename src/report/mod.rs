@@ -1,0 +1,28 @@
+//! Output: result tables (CSV, Parquet, Markdown, LaTeX), figures (PNG, SVG) and the run
+//! report, all written atomically under `out/`. Only this module and `log` touch files.
+
+pub mod atomic;
+pub mod figure;
+pub mod table;
+
+use std::path::{Path, PathBuf};
+
+pub use figure::Figure;
+pub use table::{Provenance, Table};
+
+/// Write `<dir>/<name>.png` and `<dir>/<name>.svg` atomically; returns the paths.
+pub fn write_figure(
+    dir: &Path,
+    fig: &Figure,
+    root: &Path,
+) -> Result<Vec<PathBuf>, figure::FigureError> {
+    let io = |e: std::io::Error| figure::FigureError {
+        name: fig.name.clone(),
+        reason: e.to_string(),
+    };
+    let png = dir.join(format!("{}.png", fig.name));
+    atomic::write_atomic(&png, &fig.to_png()?, Some(root)).map_err(io)?;
+    let svg = dir.join(format!("{}.svg", fig.name));
+    atomic::write_atomic(&svg, fig.to_svg()?.as_bytes(), Some(root)).map_err(io)?;
+    Ok(vec![png, svg])
+}
