@@ -3,13 +3,18 @@ CARGO ?= cargo
 PYTHON ?= python3
 VENV := target/py-venv
 
-.PHONY: help test bench interop clean
+.PHONY: help eval test bench interop clean
 
 help:
+	@echo "make eval      build (release), run every pipeline, write out/ and out/REPORT.md"
 	@echo "make test      build and run every test (the CI command)"
 	@echo "make bench     criterion benchmarks + the same reads in Python mcap-ros2-support, with ratios"
 	@echo "make interop   check that Python mcap-ros2-support opens what we write (throwaway venv)"
 	@echo "make clean     remove build outputs and out/"
+
+eval:
+	$(CARGO) build --release --locked
+	./target/release/peopletrack eval
 
 test:
 	$(CARGO) test --locked

@@ -6,8 +6,11 @@
 
 pub mod cli;
 pub mod eval;
+pub mod groundtruth;
 pub mod log;
+pub mod pipelines;
 pub mod report;
+pub mod run;
 pub mod time;
 
 pub use time::Nanos;

@@ -8,9 +8,8 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use crate::log::decode::Decoder;
-use crate::log::{Decoders, LogError, SessionLog, TfBuffer};
-use crate::time::Nanos;
+use crate::log::stats::{StatsOptions, TopicStats, topic_stats};
+use crate::log::{LogError, SessionLog, TfBuffer};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -20,26 +19,6 @@ pub struct Args {
     /// Print one JSON document per log instead of text.
     #[arg(long)]
     pub json: bool,
-}
-
-/// Per-topic facts.
-#[derive(Debug, Clone, Serialize, PartialEq)]
-pub struct TopicReport {
-    pub topic: String,
-    pub schema: String,
-    pub schema_encoding: String,
-    pub message_encoding: String,
-    pub count: u64,
-    pub first_s: f64,
-    pub last_s: f64,
-    /// Messages per second over the topic's own span ((n − 1) / span).
-    pub rate_hz: f64,
-    pub median_period_s: f64,
-    pub max_gap_s: f64,
-    /// Gaps longer than twice the median period (drops, or bursty delivery).
-    pub long_gaps: u64,
-    /// `ok` or why the channel cannot be decoded.
-    pub decoder: String,
 }
 
 /// One edge of the TF tree.
@@ -65,93 +44,25 @@ pub struct Report {
     pub start: String,
     pub end: String,
     pub duration_s: f64,
-    pub topics: Vec<TopicReport>,
+    pub topics: Vec<TopicStats>,
     pub tf_tree: Vec<TfEdge>,
     pub tf_tree_text: String,
     pub tf_skipped_invalid: u64,
     pub metadata: BTreeMap<String, BTreeMap<String, String>>,
 }
 
-fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
 /// Read the whole log once and gather the report.
 pub fn analyze(log: &SessionLog) -> Result<Report, LogError> {
     let s = log.summary();
-    let mut times: BTreeMap<u16, Vec<Nanos>> = BTreeMap::new();
-    let mut decoders = Decoders::new();
-    let mut decode_status: BTreeMap<u16, String> = BTreeMap::new();
-    let mut channels = s.channels.clone();
-    for m in log.messages()? {
-        let m = m?;
-        times.entry(m.channel.id).or_default().push(m.log_time);
-        channels
-            .entry(m.channel.id)
-            .or_insert_with(|| m.channel.clone());
-        // decode the first message of each channel to prove the channel is readable
-        decode_status
-            .entry(m.channel.id)
-            .or_insert_with(|| match decoders.value(log, &m) {
-                Ok(_) => "ok".to_string(),
-                Err(e) => e.kind.to_string(),
-            });
-    }
-    let mut topics = Vec::new();
-    for (id, ch) in &channels {
-        let t = times.get(id).map(Vec::as_slice).unwrap_or(&[]);
-        let mut periods: Vec<f64> = t
-            .windows(2)
-            .map(|w| (w[1].0 - w[0].0) as f64 * 1e-9)
-            .collect();
-        let max_gap = periods.iter().copied().fold(0.0, f64::max);
-        let med = median(&mut periods);
-        let long_gaps = periods.iter().filter(|p| **p > 2.0 * med).count() as u64;
-        let span = match (t.first(), t.last()) {
-            (Some(a), Some(b)) => (b.0 - a.0) as f64 * 1e-9,
-            _ => 0.0,
-        };
-        let decoder = match decode_status.get(id) {
-            Some(s) => s.clone(),
-            None => match Decoder::for_channel(ch) {
-                Ok(_) => "ok (no messages)".to_string(),
-                Err(e) => e.to_string(),
-            },
-        };
-        topics.push(TopicReport {
-            topic: ch.topic.clone(),
-            schema: ch.schema_name().to_string(),
-            schema_encoding: ch
-                .schema
-                .as_ref()
-                .map_or(String::new(), |x| x.encoding.clone()),
-            message_encoding: ch.message_encoding.clone(),
-            count: t.len() as u64,
-            first_s: t.first().map_or(f64::NAN, |x| x.as_secs_f64()),
-            last_s: t.last().map_or(f64::NAN, |x| x.as_secs_f64()),
-            rate_hz: if span > 0.0 {
-                (t.len() - 1) as f64 / span
-            } else {
-                0.0
-            },
-            median_period_s: med,
-            max_gap_s: max_gap,
-            long_gaps,
-            decoder,
-        });
-    }
-    topics.sort_by(|a, b| a.topic.cmp(&b.topic));
-    let start = times.values().filter_map(|t| t.first()).min().copied();
-    let end = times.values().filter_map(|t| t.last()).max().copied();
+    let topics = topic_stats(
+        log,
+        StatsOptions {
+            stamp_offsets: false,
+            bin_s: 0.0,
+        },
+    )?;
+    let start = topics.iter().filter_map(|t| t.first).min();
+    let end = topics.iter().filter_map(|t| t.last).max();
     let tf = TfBuffer::from_log(log, 0.0)?;
     let mut compression: Vec<String> = s
         .chunks
@@ -168,7 +79,7 @@ pub fn analyze(log: &SessionLog) -> Result<Report, LogError> {
         indexed_by_summary: s.from_summary_section,
         chunks: s.chunks.len(),
         compression,
-        messages: times.values().map(|v| v.len() as u64).sum(),
+        messages: topics.iter().map(|t| t.count).sum(),
         start: start.map_or(String::new(), |t| t.to_string()),
         end: end.map_or(String::new(), |t| t.to_string()),
         duration_s: match (start, end) {

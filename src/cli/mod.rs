@@ -2,7 +2,9 @@
 //! [`main`]; errors become exit codes here, in one place.
 
 pub mod cat;
+pub mod eval;
 pub mod inspect;
+pub mod run;
 
 use std::io::{self, Write};
 use std::process::ExitCode;
@@ -14,13 +16,23 @@ use clap::{Parser, Subcommand};
 #[derive(Debug, Parser)]
 #[command(name = "peopletrack", version, about, long_about = None, after_help = EXAMPLES)]
 pub struct Cli {
+    /// Worker threads for sessions, frames and cameras (default: all cores). Results do not
+    /// depend on it.
+    #[arg(long, short = 'j', global = true, value_name = "N")]
+    pub jobs: Option<usize>,
+    /// Crash test: abort just before the N-th file replacement (hidden; for tests).
+    #[arg(long, global = true, hide = true, value_name = "N")]
+    pub debug_abort_after_writes: Option<u64>,
     #[command(subcommand)]
     pub command: Command,
 }
 
 const EXAMPLES: &str = "Examples:
   peopletrack inspect ../shared/real/laser/general_tracking_moving_1/general_tracking_moving_1.mcap
-  peopletrack cat LOG.mcap --topic /scan --limit 1 --max-array 8";
+  peopletrack cat LOG.mcap --topic /scan --limit 1 --max-array 8
+  peopletrack run pipelines/dataset_quality.toml --dry-run
+  peopletrack run pipelines/dataset_quality.toml --sessions 'mylogs/*.mcap'
+  peopletrack eval                      # every pipeline, then out/REPORT.md";
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
@@ -28,17 +40,34 @@ pub enum Command {
     Inspect(inspect::Args),
     /// Print one topic's messages as JSON lines, decoded whatever their type.
     Cat(cat::Args),
+    /// Run one pipeline file: per-session processing (cached) and tables and figures in out/.
+    Run(run::Args),
+    /// Run every pipeline in pipelines/ and write out/REPORT.md.
+    Eval(eval::Args),
 }
 
 /// Parse arguments, run the command, and map the outcome to an exit code:
 /// 0 success, 1 error (printed with its causes), 2 bad usage (clap's).
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(n) = cli.jobs
+        && let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build_global()
+    {
+        eprintln!("error: cannot start {n} worker threads: {e}");
+        return ExitCode::FAILURE;
+    }
+    if let Some(n) = cli.debug_abort_after_writes {
+        crate::report::atomic::abort_before_rename(n);
+    }
     let stdout = io::stdout();
     let mut out = io::BufWriter::new(stdout.lock());
     let result = match &cli.command {
         Command::Inspect(a) => inspect::run(a, &mut out),
         Command::Cat(a) => cat::run(a, &mut out),
+        Command::Run(a) => run::run(a, &mut out),
+        Command::Eval(a) => eval::run(a, &mut out),
     }
     .and_then(|()| out.flush().map_err(anyhow::Error::from));
     match result {
@@ -57,4 +86,41 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
         c.downcast_ref::<io::Error>()
             .is_some_and(|io| io.kind() == io::ErrorKind::BrokenPipe)
     })
+}
+
+/// Short commit of the working tree (with `+dirty` if tracked files changed), or `unknown`.
+pub fn git_commit() -> String {
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    match git(&["rev-parse", "--short=12", "HEAD"]) {
+        Some(c) if !c.is_empty() => {
+            let dirty = git(&["status", "--porcelain", "--untracked-files=no"])
+                .is_some_and(|s| !s.is_empty());
+            if dirty { format!("{c}+dirty") } else { c }
+        }
+        _ => "unknown".to_string(),
+    }
+}
+
+/// `rustc --version` of the toolchain on this machine (for the report), or `unknown`.
+pub fn rustc_version() -> String {
+    std::process::Command::new("rustc")
+        .arg("--version")
+        .output()
+        .ok()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| "unknown".to_string())
+}
+
+/// Progress bars only when a person is watching.
+pub fn stderr_is_terminal() -> bool {
+    use std::io::IsTerminal;
+    io::stderr().is_terminal()
 }

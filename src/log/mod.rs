@@ -19,6 +19,7 @@ pub mod msgs;
 pub mod protobuf;
 pub mod reader;
 pub mod ros2msg;
+pub mod stats;
 pub mod sync;
 pub mod tf;
 pub mod value;

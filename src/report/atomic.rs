@@ -13,6 +13,28 @@ pub const SCRATCH_DIR: &str = ".tmp";
 
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
+/// Crash-test hook: abort the process just before the N-th rename (0 = never). Set only by the
+/// CLI's hidden `--debug-abort-after-writes` flag, to prove that a killed run leaves no
+/// partial file.
+static ABORT_AT: AtomicU64 = AtomicU64::new(0);
+static RENAMES: AtomicU64 = AtomicU64::new(0);
+
+pub fn abort_before_rename(n: u64) {
+    ABORT_AT.store(n, Ordering::SeqCst);
+}
+
+/// The crash-test hook, for other atomic swaps (session result folders).
+pub fn maybe_abort_hook() {
+    maybe_abort();
+}
+
+fn maybe_abort() {
+    let at = ABORT_AT.load(Ordering::SeqCst);
+    if at > 0 && RENAMES.fetch_add(1, Ordering::SeqCst) + 1 >= at {
+        std::process::abort();
+    }
+}
+
 /// The scratch folder for `path`: `<root>/.tmp` where root is the nearest ancestor named by
 /// the caller, or the file's own directory.
 fn scratch_for(path: &Path, root: Option<&Path>) -> PathBuf {
@@ -41,6 +63,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8], root: Option<&Path>) -> io::Resul
         let mut f = fs::File::create(&tmp)?;
         f.write_all(bytes)?;
         f.sync_all()?;
+        maybe_abort();
         fs::rename(&tmp, path)
     })();
     if result.is_err() {

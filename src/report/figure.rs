@@ -29,16 +29,17 @@ fn register_font() {
     });
 }
 
-/// Okabe–Ito: black, orange, sky blue, bluish green, yellow, blue, vermillion, reddish purple.
+/// Okabe–Ito: black, orange, sky blue, bluish green, blue, vermillion, reddish purple, yellow
+/// (yellow last: it is hard to read as a thin line on white).
 pub const PALETTE: [RGBColor; 8] = [
     RGBColor(0, 0, 0),
     RGBColor(230, 159, 0),
     RGBColor(86, 180, 233),
     RGBColor(0, 158, 115),
-    RGBColor(240, 228, 66),
     RGBColor(0, 114, 178),
     RGBColor(213, 94, 0),
     RGBColor(204, 121, 167),
+    RGBColor(240, 228, 66),
 ];
 
 pub fn color(i: usize) -> RGBColor {

@@ -1,0 +1,86 @@
+//! `peopletrack run PIPELINE.toml`: one pipeline — plan, per-session processing (cached), and
+//! aggregation into tables and figures under `out/<pipeline>/`.
+
+use std::path::PathBuf;
+
+use crate::pipelines;
+use crate::report::atomic;
+use crate::run::RunOptions;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Pipeline file, e.g. pipelines/dataset_quality.toml.
+    pub pipeline: PathBuf,
+    /// Run on these sessions instead of the file's [inputs] (glob; repeat for more).
+    #[arg(long, value_name = "GLOB")]
+    pub sessions: Vec<String>,
+    /// Print which sessions, topics and stages would run, and stop.
+    #[arg(long)]
+    pub dry_run: bool,
+    /// Process only shard K of N (1-based) and skip aggregation: for array jobs on a cluster.
+    #[arg(long, value_name = "K/N", value_parser = parse_shard)]
+    pub shard: Option<(usize, usize)>,
+    /// Aggregate cached per-session results only (after all shards ran).
+    #[arg(long, conflicts_with = "shard")]
+    pub aggregate_only: bool,
+    /// Recompute sessions even when a cached result matches.
+    #[arg(long)]
+    pub force: bool,
+    /// Output root.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+}
+
+fn parse_shard(s: &str) -> Result<(usize, usize), String> {
+    let (k, n) = s.split_once('/').ok_or("expected K/N, e.g. 3/10")?;
+    let (k, n): (usize, usize) = (
+        k.parse().map_err(|_| "K is not a number")?,
+        n.parse().map_err(|_| "N is not a number")?,
+    );
+    if n == 0 || k == 0 || k > n {
+        return Err(format!("shard {k}/{n}: need 1 <= K <= N"));
+    }
+    Ok((k, n))
+}
+
+pub fn options(a: &Args, progress: bool) -> RunOptions {
+    RunOptions {
+        sessions: (!a.sessions.is_empty()).then(|| a.sessions.clone()),
+        dry_run: a.dry_run,
+        shard: a.shard,
+        aggregate_only: a.aggregate_only,
+        force: a.force,
+        out: a.out.clone(),
+        git_commit: super::git_commit(),
+        progress,
+    }
+}
+
+pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
+    let opts = options(a, super::stderr_is_terminal());
+    if !a.dry_run {
+        atomic::sweep_scratch(&a.out)?;
+    }
+    let s = pipelines::run_file(&a.pipeline, &opts)?;
+    if a.dry_run {
+        write!(out, "{}", s.plan)?;
+        return Ok(());
+    }
+    writeln!(
+        out,
+        "{}: {} sessions ({} computed, {} from cache, {} skipped) in {:.1} s",
+        s.pipeline,
+        s.sessions,
+        s.computed,
+        s.cached,
+        s.skipped.len(),
+        s.seconds
+    )?;
+    for (t, p) in s.tables.iter().chain(&s.figures) {
+        writeln!(out, "  {}  {t}", a.out.join(p).display())?;
+    }
+    for (session, why) in &s.skipped {
+        eprintln!("warning: skipped {session}: {why}");
+    }
+    Ok(())
+}

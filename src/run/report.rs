@@ -1,0 +1,143 @@
+//! `out/REPORT.md`: one section per pipeline with its summary lines, every table inline (and
+//! linked as CSV, Parquet, LaTeX), every figure, skipped sessions with reasons, and versions
+//! and timings. Pure: the caller reads the table files and writes the result.
+
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+use super::RunSummary;
+
+/// Versions and totals printed at the top.
+#[derive(Debug, Clone)]
+pub struct Header {
+    pub tool_version: String,
+    pub git_commit: String,
+    pub rustc: String,
+    pub total_seconds: f64,
+}
+
+/// Render the report. `tables_md` maps a table's Markdown path (relative to `out/`) to its text.
+pub fn render(runs: &[RunSummary], tables_md: &BTreeMap<String, String>, h: &Header) -> String {
+    let mut o = String::new();
+    let _ = writeln!(o, "# peopletrack report\n");
+    let _ = writeln!(
+        o,
+        "peopletrack {} (commit {}), built with {}; {} pipelines in {:.1} s. Timings vary between runs; tables do not.\n",
+        h.tool_version,
+        h.git_commit,
+        h.rustc,
+        runs.len(),
+        h.total_seconds
+    );
+    let _ = writeln!(
+        o,
+        "| pipeline | sessions | computed | from cache | skipped | tables | figures | time (s) |"
+    );
+    let _ = writeln!(
+        o,
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+    );
+    for r in runs {
+        let _ = writeln!(
+            o,
+            "| [{}](#{}) | {} | {} | {} | {} | {} | {} | {:.1} |",
+            r.title,
+            anchor(&r.title),
+            r.sessions,
+            r.computed,
+            r.cached,
+            r.skipped.len(),
+            r.tables.len(),
+            r.figures.len(),
+            r.seconds
+        );
+    }
+    for r in runs {
+        let _ = writeln!(o, "\n## {}\n", r.title);
+        let _ = writeln!(o, "Pipeline `{}` (`{}`).\n", r.pipeline, r.file);
+        for line in &r.summary {
+            let _ = writeln!(o, "- {line}");
+        }
+        if !r.summary.is_empty() {
+            o.push('\n');
+        }
+        for (title, path) in &r.tables {
+            let stem = path.trim_end_matches(".md");
+            let _ = writeln!(o, "### {title}\n");
+            if let Some(md) = tables_md.get(path) {
+                // the table file starts with its own bold caption; drop it here
+                let body = md.split_once("\n\n").map_or(md.as_str(), |(_, rest)| rest);
+                let _ = writeln!(o, "{}", body.trim_end());
+            }
+            let _ = writeln!(
+                o,
+                "\nFiles: [md]({path}) · [csv]({stem}.csv) · [parquet]({stem}.parquet) · [tex]({stem}.tex)\n"
+            );
+        }
+        for (title, path) in &r.figures {
+            let svg = path.trim_end_matches(".png");
+            let _ = writeln!(o, "### {title}\n\n![{title}]({path})\n\n[svg]({svg}.svg)\n");
+        }
+        if !r.skipped.is_empty() {
+            let _ = writeln!(o, "### Skipped sessions ({})\n", r.skipped.len());
+            for (s, why) in &r.skipped {
+                let _ = writeln!(o, "- `{s}`: {why}");
+            }
+            o.push('\n');
+        }
+    }
+    o
+}
+
+/// GitHub-style heading anchor.
+fn anchor(title: &str) -> String {
+    title
+        .to_lowercase()
+        .chars()
+        .filter_map(|c| match c {
+            'a'..='z' | '0'..='9' | '-' | '_' => Some(c),
+            ' ' => Some('-'),
+            _ => None,
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn report_lists_tables_figures_and_skips() {
+        let run = RunSummary {
+            pipeline: "dataset_quality".into(),
+            title: "Dataset quality".into(),
+            file: "pipelines/dataset_quality.toml".into(),
+            sessions: 3,
+            computed: 2,
+            cached: 0,
+            skipped: vec![("lab/broken".into(), "file is truncated".into())],
+            tables: vec![(
+                "Sessions".into(),
+                "dataset_quality/tables/sessions.md".into(),
+            )],
+            figures: vec![(
+                "Rates".into(),
+                "dataset_quality/figures/rates_lab.png".into(),
+            )],
+            summary: vec!["3 sessions.".into()],
+            seconds: 1.25,
+            plan: String::new(),
+        };
+        let md = BTreeMap::from([(
+            "dataset_quality/tables/sessions.md".to_string(),
+            "**Sessions**\n\n| a |\n| --- |\n| 1 |\n".to_string(),
+        )]);
+        let h = Header {
+            tool_version: "0.1.0".into(),
+            git_commit: "abc".into(),
+            rustc: "rustc 1.95.0".into(),
+            total_seconds: 1.5,
+        };
+        insta::assert_snapshot!(render(&[run], &md, &h));
+    }
+}
