@@ -6,11 +6,13 @@
 
 pub mod cli;
 pub mod eval;
+pub mod geometry;
 pub mod groundtruth;
 pub mod log;
 pub mod pipelines;
 pub mod report;
 pub mod run;
+pub mod synth;
 pub mod time;
 
 pub use time::Nanos;

@@ -5,6 +5,7 @@ pub mod cat;
 pub mod eval;
 pub mod inspect;
 pub mod run;
+pub mod synth;
 
 use std::io::{self, Write};
 use std::process::ExitCode;
@@ -32,7 +33,8 @@ const EXAMPLES: &str = "Examples:
   peopletrack cat LOG.mcap --topic /scan --limit 1 --max-array 8
   peopletrack run pipelines/dataset_quality.toml --dry-run
   peopletrack run pipelines/dataset_quality.toml --sessions 'mylogs/*.mcap'
-  peopletrack eval                      # every pipeline, then out/REPORT.md";
+  peopletrack eval                      # every pipeline, then out/REPORT.md
+  peopletrack synth datasets/omni_lab/scenario.toml --profile full";
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
@@ -44,6 +46,8 @@ pub enum Command {
     Run(run::Args),
     /// Run every pipeline in pipelines/ and write out/REPORT.md.
     Eval(eval::Args),
+    /// Render a synthetic dataset (sessions as MCAP logs, and a preview sheet).
+    Synth(synth::Args),
 }
 
 /// Parse arguments, run the command, and map the outcome to an exit code:
@@ -68,6 +72,7 @@ pub fn main() -> ExitCode {
         Command::Cat(a) => cat::run(a, &mut out),
         Command::Run(a) => run::run(a, &mut out),
         Command::Eval(a) => eval::run(a, &mut out),
+        Command::Synth(a) => synth::run(a, &mut out),
     }
     .and_then(|()| out.flush().map_err(anyhow::Error::from));
     match result {

@@ -1,0 +1,71 @@
+//! `peopletrack synth SCENARIO.toml`: render a synthetic dataset's sessions as MCAP logs, and
+//! its preview sheet.
+
+use std::path::PathBuf;
+
+use crate::synth::{self, SynthOptions};
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Scenario files, e.g. datasets/omni_lab/scenario.toml.
+    #[arg(required = true, value_name = "SCENARIO")]
+    pub scenarios: Vec<PathBuf>,
+    /// Profile: `quick` (small, the default datasets) or `full` (paper-sized).
+    #[arg(long, default_value = "quick")]
+    pub profile: String,
+    /// Folder for the logs (default: the scenario's folder; `full/` below it for `full`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Folder for preview sheets (`<dir>/<name>/preview.png`).
+    #[arg(long, default_value = "out/datasets")]
+    pub preview: PathBuf,
+    /// Skip scenarios whose logs already exist.
+    #[arg(long)]
+    pub if_absent: bool,
+}
+
+pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
+    for scenario in &a.scenarios {
+        let dir = a
+            .out
+            .clone()
+            .unwrap_or_else(|| synth::default_out(scenario, &a.profile));
+        if a.if_absent
+            && std::fs::read_dir(&dir).is_ok_and(|mut d| {
+                d.any(|e| e.is_ok_and(|e| e.path().extension().is_some_and(|x| x == "mcap")))
+            })
+        {
+            writeln!(
+                out,
+                "{}: logs exist in {}, skipped",
+                scenario.display(),
+                dir.display()
+            )?;
+            continue;
+        }
+        let started = std::time::Instant::now();
+        let s = synth::synthesize(
+            scenario,
+            &SynthOptions {
+                profile: a.profile.clone(),
+                out: a.out.clone(),
+                preview_root: Some(a.preview.clone()),
+                progress: super::stderr_is_terminal(),
+            },
+        )?;
+        writeln!(
+            out,
+            "{}: {} sessions in {:.1} s",
+            s.name,
+            s.sessions.len(),
+            started.elapsed().as_secs_f64()
+        )?;
+        for p in &s.sessions {
+            writeln!(out, "  {}", p.display())?;
+        }
+        if let Some(p) = &s.preview {
+            writeln!(out, "  preview {}", p.display())?;
+        }
+    }
+    Ok(())
+}
