@@ -3,6 +3,7 @@
 
 pub mod cat;
 pub mod inspect;
+pub mod score;
 
 use std::io::{self, Write};
 use std::process::ExitCode;
@@ -28,6 +29,9 @@ pub enum Command {
     Inspect(inspect::Args),
     /// Print one topic's messages as JSON lines, decoded whatever their type.
     Cat(cat::Args),
+    /// Score tracks against ground truth (MOTChallenge CSV): HOTA, CLEAR MOT (MOTA, MOTP,
+    /// switches, MT/PT/ML) and IDF1.
+    Score(score::Args),
 }
 
 /// Parse arguments, run the command, and map the outcome to an exit code:
@@ -39,6 +43,7 @@ pub fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Inspect(a) => inspect::run(a, &mut out),
         Command::Cat(a) => cat::run(a, &mut out),
+        Command::Score(a) => score::run(a, &mut out),
     }
     .and_then(|()| out.flush().map_err(anyhow::Error::from));
     match result {
