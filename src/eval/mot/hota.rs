@@ -236,7 +236,11 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> Hota {
         .map(|(k, mut a)| {
             let tp = (a.num_tp as f64).max(1.0);
             let (mut ass_a, mut ass_re, mut ass_pr) = (0.0, 0.0, 0.0);
-            for (&(g, t), &m) in &matches[k] {
+            // Sorted, so the sum is the same on every run.
+            let mut pairs: Vec<((usize, usize), u64)> =
+                matches[k].iter().map(|(&p, &m)| (p, m)).collect();
+            pairs.sort_unstable();
+            for ((g, t), m) in pairs {
                 let (m, gc, tc) = (m as f64, gt_count[g] as f64, hyp_count[t] as f64);
                 ass_a += m * m / (gc + tc - m).max(1.0);
                 ass_re += m * m / gc.max(1.0);

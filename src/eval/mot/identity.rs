@@ -68,7 +68,9 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> IdMetrics 
             }
         }
     }
-    let edges: Vec<(usize, usize, u64)> = agree.iter().map(|(&(o, h), &n)| (o, h, n)).collect();
+    let mut edges: Vec<(usize, usize, u64)> = agree.iter().map(|(&(o, h), &n)| (o, h, n)).collect();
+    // Sorted, so ties between equally good matchings break the same way on every run.
+    edges.sort_unstable();
     let idtp: u64 = max_count_pairs(n_gt, n_hyp, &edges)
         .iter()
         .map(|p| agree.get(p).copied().unwrap_or(0))
