@@ -152,24 +152,25 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> Hota {
         return Hota::from_alphas(per_alpha);
     }
 
-    // 1. Global alignment A(g, t), kept only for pairs that ever overlap.
-    let mut potential: HashMap<(usize, usize), f64> = HashMap::new();
+    // 1. Global alignment A(g, t), for the pairs that ever overlap. Each such pair gets a
+    //    dense index; `entry_pair` holds it for every similarity entry of every frame.
+    const NO_PAIR: u32 = u32::MAX;
+    let mut pair_of: HashMap<(usize, usize), u32> = HashMap::new();
+    let mut pairs: Vec<(usize, usize)> = Vec::new();
+    let mut potential: Vec<f64> = Vec::new();
+    let mut entry_pair: Vec<u32> = Vec::with_capacity(frames.iter().map(|f| f.sim.len()).sum());
     let mut gt_count = vec![0u64; n_gt];
     let mut hyp_count = vec![0u64; n_hyp];
     let mut row_sum = Vec::new();
     let mut col_sum = Vec::new();
     for f in frames {
         let nh = f.hyp.len();
+        let rows = || f.sim.chunks(nh.max(1)).take(f.gt.len());
         row_sum.clear();
-        row_sum.extend(
-            f.sim
-                .chunks(nh.max(1))
-                .take(f.gt.len())
-                .map(|r| r.iter().sum::<f64>()),
-        );
+        row_sum.extend(rows().map(|r| r.iter().sum::<f64>()));
         col_sum.clear();
         col_sum.resize(nh, 0.0);
-        for row in f.sim.chunks(nh.max(1)).take(f.gt.len()) {
+        for row in rows() {
             for (sum, s) in col_sum.iter_mut().zip(row) {
                 *sum += s;
             }
@@ -177,9 +178,19 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> Hota {
         for (i, &g) in f.gt.iter().enumerate() {
             for (j, &t) in f.hyp.iter().enumerate() {
                 let s = f.sim[i * nh + j];
+                if s <= 0.0 {
+                    entry_pair.push(NO_PAIR);
+                    continue;
+                }
+                let p = *pair_of.entry((g, t)).or_insert_with(|| {
+                    pairs.push((g, t));
+                    potential.push(0.0);
+                    (pairs.len() - 1) as u32
+                });
+                entry_pair.push(p);
                 let denom = col_sum[j] + row_sum[i] - s;
-                if s > 0.0 && denom > f64::EPSILON {
-                    *potential.entry((g, t)).or_default() += s / denom;
+                if denom > f64::EPSILON {
+                    potential[p as usize] += s / denom;
                 }
             }
         }
@@ -190,18 +201,21 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> Hota {
             hyp_count[t] += 1;
         }
     }
-    let alignment = |g: usize, t: usize| -> f64 {
-        potential
-            .get(&(g, t))
-            .map_or(0.0, |&p| p / (gt_count[g] as f64 + hyp_count[t] as f64 - p))
-    };
+    let alignment: Vec<f64> = pairs
+        .iter()
+        .zip(&potential)
+        .map(|(&(g, t), &p)| p / (gt_count[g] as f64 + hyp_count[t] as f64 - p))
+        .collect();
 
     // 2–3. Per-frame matching, scored at every α.
     let mut per_alpha: Vec<HotaAtAlpha> = (0..HOTA_ALPHAS).map(HotaAtAlpha::zero).collect();
     let mut loc_sum = [0.0f64; HOTA_ALPHAS];
-    let mut matches: Vec<HashMap<(usize, usize), u64>> = vec![HashMap::new(); HOTA_ALPHAS];
+    let mut matches: Vec<Vec<u64>> = vec![vec![0; pairs.len()]; HOTA_ALPHAS];
+    let mut offset = 0;
     for f in frames {
         let (ng, nh) = (f.gt.len(), f.hyp.len());
+        let entries = &entry_pair[offset..offset + ng * nh];
+        offset += ng * nh;
         if ng == 0 || nh == 0 {
             for a in per_alpha.iter_mut() {
                 a.num_fp += nh as u64;
@@ -209,18 +223,22 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> Hota {
             }
             continue;
         }
-        let pairs = max_score_pairs(ng, nh, |i, j| {
-            alignment(f.gt[i], f.hyp[j]) * f.sim[i * nh + j]
+        let assigned = max_score_pairs(ng, nh, |i, j| match entries[i * nh + j] {
+            NO_PAIR => 0.0,
+            p => alignment[p as usize] * f.sim[i * nh + j],
         });
         for (k, a) in per_alpha.iter_mut().enumerate() {
             let alpha = hota_alpha(k);
             let mut n = 0u64;
-            for &(i, j) in &pairs {
+            for &(i, j) in &assigned {
                 let s = f.sim[i * nh + j];
                 if s >= alpha - ALPHA_EPS {
                     n += 1;
                     loc_sum[k] += s;
-                    *matches[k].entry((f.gt[i], f.hyp[j])).or_default() += 1;
+                    // s ≥ α > 0, so the pair has an index.
+                    if let Some(m) = matches[k].get_mut(entries[i * nh + j] as usize) {
+                        *m += 1;
+                    }
                 }
             }
             a.num_tp += n;
@@ -236,11 +254,7 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> Hota {
         .map(|(k, mut a)| {
             let tp = (a.num_tp as f64).max(1.0);
             let (mut ass_a, mut ass_re, mut ass_pr) = (0.0, 0.0, 0.0);
-            // Sorted, so the sum is the same on every run.
-            let mut pairs: Vec<((usize, usize), u64)> =
-                matches[k].iter().map(|(&p, &m)| (p, m)).collect();
-            pairs.sort_unstable();
-            for ((g, t), m) in pairs {
+            for (&(g, t), &m) in pairs.iter().zip(&matches[k]).filter(|(_, m)| **m > 0) {
                 let (m, gc, tc) = (m as f64, gt_count[g] as f64, hyp_count[t] as f64);
                 ass_a += m * m / (gc + tc - m).max(1.0);
                 ass_re += m * m / gc.max(1.0);

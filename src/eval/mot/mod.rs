@@ -49,7 +49,7 @@ mod hota;
 mod identity;
 mod motchallenge;
 
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{BTreeMap, HashMap};
 
 pub use clear::{ClearMot, Event, EventKind};
 pub use error::{MotError, Side};
@@ -254,27 +254,42 @@ impl Sequence {
             MatchRule::Iou { min_iou } => 1.0 - min_iou,
             MatchRule::Euclidean { max_m } => max_m * max_m,
         };
-        let frames = by_frame
-            .into_iter()
-            .map(|(frame, (g, h))| {
-                let mut dist = Vec::with_capacity(g.len() * h.len());
-                let mut sim = Vec::with_capacity(g.len() * h.len());
-                for &i in &g {
-                    for &j in &h {
-                        let (d, s) = pair(&gt[i].geometry, &hyp[j].geometry, rule, max_dist);
-                        dist.push(d);
-                        sim.push(s);
+        // Frame index in which each dense id was last seen, to find an id twice in a frame.
+        let mut gt_seen = vec![usize::MAX; gt_ids.len()];
+        let mut hyp_seen = vec![usize::MAX; hyp_ids.len()];
+        let mut frames = Vec::with_capacity(by_frame.len());
+        for (fi, (frame, (g, h))) in by_frame.into_iter().enumerate() {
+            for (rows, dense, seen, side, obs) in [
+                (&g, &gt_dense, &mut gt_seen, Side::GroundTruth, gt),
+                (&h, &hyp_dense, &mut hyp_seen, Side::Hypothesis, hyp),
+            ] {
+                for &k in rows {
+                    if std::mem::replace(&mut seen[dense[k]], fi) == fi {
+                        return Err(MotError::DuplicateId {
+                            side,
+                            frame,
+                            id: obs[k].id,
+                        });
                     }
                 }
-                Frame {
-                    frame,
-                    gt: g.iter().map(|&i| gt_dense[i]).collect(),
-                    hyp: h.iter().map(|&j| hyp_dense[j]).collect(),
-                    dist,
-                    sim,
+            }
+            let mut dist = Vec::with_capacity(g.len() * h.len());
+            let mut sim = Vec::with_capacity(g.len() * h.len());
+            for &i in &g {
+                for &j in &h {
+                    let (d, s) = pair(&gt[i].geometry, &hyp[j].geometry, rule, max_dist);
+                    dist.push(d);
+                    sim.push(s);
                 }
-            })
-            .collect();
+            }
+            frames.push(Frame {
+                frame,
+                gt: g.iter().map(|&i| gt_dense[i]).collect(),
+                hyp: h.iter().map(|&j| hyp_dense[j]).collect(),
+                dist,
+                sim,
+            });
+        }
         Ok(Sequence {
             rule,
             gt_ids,
@@ -345,7 +360,6 @@ fn intern(
 ) -> Result<(Vec<i64>, Vec<usize>), MotError> {
     let mut ids = Vec::new();
     let mut index: HashMap<i64, usize> = HashMap::new();
-    let mut seen: HashSet<(i64, i64)> = HashSet::with_capacity(obs.len());
     let mut dense = Vec::with_capacity(obs.len());
     for o in obs {
         if !(o.geometry.is_finite() && o.confidence.is_finite()) {
@@ -363,13 +377,6 @@ fn intern(
                 rule: rule.name(),
                 expected: rule.geometry().name(),
                 found: o.geometry.kind().name(),
-            });
-        }
-        if !seen.insert((o.frame, o.id)) {
-            return Err(MotError::DuplicateId {
-                side,
-                frame: o.frame,
-                id: o.id,
             });
         }
         let next = ids.len();

@@ -32,8 +32,8 @@ const COLUMNS: [&str; 10] = [
 ];
 
 /// Parse MOTChallenge CSV text; `path` only names the source in errors.
-pub fn parse_motchallenge(
-    text: &str,
+pub fn parse_motchallenge<'a>(
+    text: &'a str,
     path: &Path,
     kind: GeometryKind,
 ) -> Result<Vec<Observation>, MotError> {
@@ -41,8 +41,10 @@ pub fn parse_motchallenge(
         GeometryKind::Box => (6, "6 to 10"),
         GeometryKind::Point => (9, "9 or 10 for ground-plane points"),
     };
-    let mut out = Vec::new();
-    let mut first_line: HashMap<(i64, i64), usize> = HashMap::new();
+    // A rough row count, to grow the tables once or twice rather than a dozen times.
+    let rows_guess = text.len() / 48;
+    let mut out = Vec::with_capacity(rows_guess);
+    let mut first_line: HashMap<(i64, i64), usize> = HashMap::with_capacity(rows_guess);
     let mut any_ground_plane = false;
     for (k, raw) in text.lines().enumerate() {
         let line = k + 1;
@@ -50,16 +52,24 @@ pub fn parse_motchallenge(
         if row.is_empty() {
             continue;
         }
-        let fields: Vec<&str> = if row.contains(',') {
-            row.split(',').map(str::trim).collect()
-        } else {
-            row.split_whitespace().collect()
+        let mut fields = [""; COLUMNS.len()];
+        let mut n = 0;
+        let mut take = |f: &'a str| {
+            if let Some(slot) = fields.get_mut(n) {
+                *slot = f;
+            }
+            n += 1;
         };
-        if fields.len() < min_cols || fields.len() > COLUMNS.len() {
+        if row.contains(',') {
+            row.split(',').map(str::trim).for_each(&mut take);
+        } else {
+            row.split_whitespace().for_each(&mut take);
+        }
+        if n < min_cols || n > COLUMNS.len() {
             return Err(MotError::ColumnCount {
                 path: path.to_path_buf(),
                 line,
-                found: fields.len(),
+                found: n,
                 expected,
             });
         }
@@ -71,7 +81,7 @@ pub fn parse_motchallenge(
         };
         let frame = integer(0)?;
         let id = integer(1)?;
-        let confidence = if fields.len() > 6 { number(6)? } else { 1.0 };
+        let confidence = if n > 6 { number(6)? } else { 1.0 };
         let geometry = match kind {
             GeometryKind::Box => {
                 let (width_px, height_px) = (number(4)?, number(5)?);
