@@ -9,6 +9,7 @@ help:
 	@echo "make eval      build (release), run every pipeline, write out/ and out/REPORT.md"
 	@echo "make test      build and run every test (the CI command)"
 	@echo "make bench     criterion benchmarks + the same reads in Python mcap-ros2-support, with ratios"
+	@echo "make bench-mot tracking metrics: criterion on a synthetic sequence + py-motmetrics on the same files, with the ratio"
 	@echo "make interop   check that Python mcap-ros2-support opens what we write (throwaway venv)"
 	@echo "make clean     remove build outputs and out/"
 
@@ -33,6 +34,17 @@ bench: $(VENV)/ok
 	$(CARGO) bench --bench read_decode -- --noplot
 	$(VENV)/bin/python tools/bench_python_read.py target/bench-data/python_read.json
 	$(VENV)/bin/python tools/bench_compare.py target/criterion target/bench-data/python_read.json
+
+# py-motmetrics 1.4.0 calls np.asfarray, which numpy 2 removed: pin the last numpy 1 stack.
+$(VENV)/mot-ok:
+	$(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check motmetrics==1.4.0 numpy==1.26.4 pandas==2.2.3 scipy==1.13.1
+	touch $@
+
+.PHONY: bench-mot
+bench-mot: $(VENV)/mot-ok
+	$(CARGO) bench --bench mot -- --noplot
+	$(VENV)/bin/python tools/bench_motmetrics.py target/bench-data/mot target/criterion 3
 
 clean:
 	$(CARGO) clean

@@ -5,6 +5,7 @@ pub mod cat;
 pub mod eval;
 pub mod inspect;
 pub mod run;
+pub mod score;
 pub mod synth;
 
 use std::io::{self, Write};
@@ -48,6 +49,9 @@ pub enum Command {
     Eval(eval::Args),
     /// Render a synthetic dataset (sessions as MCAP logs, and a preview sheet).
     Synth(synth::Args),
+    /// Score tracks against ground truth (MOTChallenge CSV): HOTA, CLEAR MOT (MOTA, MOTP,
+    /// switches, MT/PT/ML) and IDF1.
+    Score(score::Args),
 }
 
 /// Parse arguments, run the command, and map the outcome to an exit code:
@@ -73,6 +77,7 @@ pub fn main() -> ExitCode {
         Command::Run(a) => run::run(a, &mut out),
         Command::Eval(a) => eval::run(a, &mut out),
         Command::Synth(a) => synth::run(a, &mut out),
+        Command::Score(a) => score::run(a, &mut out),
     }
     .and_then(|()| out.flush().map_err(anyhow::Error::from));
     match result {

@@ -1,0 +1,360 @@
+//! MOTChallenge CSV text: `frame,id,bb_left,bb_top,bb_width,bb_height,conf,x,y,z`, one row
+//! per object per frame (Milan et al., "MOT16", arXiv:1603.00831, §3.3).
+//!
+//! - Boxes ([`GeometryKind::Box`]): columns 3–6 in pixels; 6 to 10 columns are accepted
+//!   (a missing `conf` reads as 1). Other columns are ignored, so MOT16/17 ground truth
+//!   (`conf, class, visibility` in 7–9) reads too, unfiltered.
+//! - Ground-plane points ([`GeometryKind::Point`]): columns 8 and 9 (`x`, `y`) in metres, as
+//!   in MOT15's 3-D files; 9 or 10 columns; the box columns are ignored (may be −1). A file in
+//!   which every row has x = y = −1 (the 2-D files' "unused") is refused.
+//! - Fields are separated by commas (spaces around them allowed) or, in a row without
+//!   commas, by whitespace, as motmetrics reads them. `frame` and `id` are integers
+//!   (`12` or `12.0`). Blank lines are skipped. Any other bad row is an error naming the
+//!   file and 1-based line, as is a second row for the same frame and id.
+
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::{BoxPx, Geometry, GeometryKind, GroundPoint, MotError, Observation};
+
+const COLUMNS: [&str; 10] = [
+    "frame",
+    "id",
+    "bb_left",
+    "bb_top",
+    "bb_width",
+    "bb_height",
+    "conf",
+    "x",
+    "y",
+    "z",
+];
+
+/// Parse MOTChallenge CSV text; `path` only names the source in errors.
+pub fn parse_motchallenge<'a>(
+    text: &'a str,
+    path: &Path,
+    kind: GeometryKind,
+) -> Result<Vec<Observation>, MotError> {
+    let (min_cols, expected) = match kind {
+        GeometryKind::Box => (6, "6 to 10"),
+        GeometryKind::Point => (9, "9 or 10 for ground-plane points"),
+    };
+    // A rough row count, to grow the tables once or twice rather than a dozen times.
+    let rows_guess = text.len() / 48;
+    let mut out = Vec::with_capacity(rows_guess);
+    let mut first_line: HashMap<(i64, i64), usize> = HashMap::with_capacity(rows_guess);
+    let mut any_ground_plane = false;
+    for (k, raw) in text.lines().enumerate() {
+        let line = k + 1;
+        let row = raw.trim();
+        if row.is_empty() {
+            continue;
+        }
+        let mut fields = [""; COLUMNS.len()];
+        let mut n = 0;
+        let mut take = |f: &'a str| {
+            if let Some(slot) = fields.get_mut(n) {
+                *slot = f;
+            }
+            n += 1;
+        };
+        if row.contains(',') {
+            row.split(',').map(str::trim).for_each(&mut take);
+        } else {
+            row.split_whitespace().for_each(&mut take);
+        }
+        if n < min_cols || n > COLUMNS.len() {
+            return Err(MotError::ColumnCount {
+                path: path.to_path_buf(),
+                line,
+                found: n,
+                expected,
+            });
+        }
+        let integer = |c: usize| {
+            parse_integer(fields[c]).ok_or_else(|| bad(path, line, c, fields[c], "an integer"))
+        };
+        let number = |c: usize| {
+            parse_finite(fields[c]).ok_or_else(|| bad(path, line, c, fields[c], "a finite number"))
+        };
+        let frame = integer(0)?;
+        let id = integer(1)?;
+        let confidence = if n > 6 { number(6)? } else { 1.0 };
+        let geometry = match kind {
+            GeometryKind::Box => {
+                let (width_px, height_px) = (number(4)?, number(5)?);
+                for (c, v) in [(4, width_px), (5, height_px)] {
+                    if v < 0.0 {
+                        return Err(MotError::NegativeSize {
+                            path: path.to_path_buf(),
+                            line,
+                            column: COLUMNS[c],
+                            value: v,
+                        });
+                    }
+                }
+                Geometry::Box(BoxPx {
+                    left_px: number(2)?,
+                    top_px: number(3)?,
+                    width_px,
+                    height_px,
+                })
+            }
+            GeometryKind::Point => {
+                let (x_m, y_m) = (number(7)?, number(8)?);
+                any_ground_plane |= !(x_m == -1.0 && y_m == -1.0);
+                Geometry::Point(GroundPoint { x_m, y_m })
+            }
+        };
+        if let Some(&first) = first_line.get(&(frame, id)) {
+            return Err(MotError::DuplicateRow {
+                path: path.to_path_buf(),
+                line,
+                first_line: first,
+                frame,
+                id,
+            });
+        }
+        first_line.insert((frame, id), line);
+        out.push(Observation {
+            frame,
+            id,
+            geometry,
+            confidence,
+        });
+    }
+    if kind == GeometryKind::Point && !out.is_empty() && !any_ground_plane {
+        return Err(MotError::NoGroundPlane {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok(out)
+}
+
+/// MOTChallenge CSV text, one row per observation in the given order; unused columns are
+/// −1 (boxes: x, y, z; points: the box and z). Numbers are written in Rust's shortest
+/// round-trip form, so [`parse_motchallenge`] reads back the same values.
+pub fn write_motchallenge(observations: &[Observation]) -> String {
+    let mut s = String::with_capacity(observations.len() * 48);
+    for o in observations {
+        // Writing to a String cannot fail.
+        let _ = match o.geometry {
+            Geometry::Box(b) => writeln!(
+                s,
+                "{},{},{},{},{},{},{},-1,-1,-1",
+                o.frame, o.id, b.left_px, b.top_px, b.width_px, b.height_px, o.confidence
+            ),
+            Geometry::Point(p) => writeln!(
+                s,
+                "{},{},-1,-1,-1,-1,{},{},{},-1",
+                o.frame, o.id, o.confidence, p.x_m, p.y_m
+            ),
+        };
+    }
+    s
+}
+
+fn bad(path: &Path, line: usize, column: usize, value: &str, wanted: &'static str) -> MotError {
+    MotError::BadNumber {
+        path: path.to_path_buf(),
+        line,
+        column: COLUMNS[column],
+        value: value.to_string(),
+        wanted,
+    }
+}
+
+fn parse_finite(s: &str) -> Option<f64> {
+    s.parse::<f64>().ok().filter(|v| v.is_finite())
+}
+
+/// `12`, or a float with no fractional part such as `12.0` (some trackers write ids so).
+fn parse_integer(s: &str) -> Option<i64> {
+    if let Ok(v) = s.parse::<i64>() {
+        return Some(v);
+    }
+    let v = parse_finite(s)?;
+    // 2^63 as f64; anything at or beyond it does not fit an i64.
+    const LIMIT: f64 = 9_223_372_036_854_775_808.0;
+    (v.fract() == 0.0 && v.abs() < LIMIT).then_some(v as i64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str, kind: GeometryKind) -> Result<Vec<Observation>, MotError> {
+        parse_motchallenge(text, Path::new("runs/hyp.txt"), kind)
+    }
+
+    /// The error message, which must name the file and the line.
+    fn err(text: &str, kind: GeometryKind) -> String {
+        match parse(text, kind) {
+            Ok(v) => panic!("parsed {v:?}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn reads_2d_rows_in_both_separators() {
+        let text = "1,3,113.84,274.5,57.307,130.05,-1,-1,-1,-1\n\n2 4 1 2 3 4 0.5 -1 -1 -1\n";
+        let v = parse(text, GeometryKind::Box).expect("valid test input");
+        assert_eq!(v.len(), 2);
+        assert_eq!((v[0].frame, v[0].id, v[0].confidence), (1, 3, -1.0));
+        assert_eq!(
+            v[0].geometry,
+            Geometry::Box(BoxPx {
+                left_px: 113.84,
+                top_px: 274.5,
+                width_px: 57.307,
+                height_px: 130.05
+            })
+        );
+        assert_eq!((v[1].frame, v[1].id, v[1].confidence), (2, 4, 0.5));
+    }
+
+    #[test]
+    fn short_rows_and_float_ids() {
+        let v = parse("7.0, 2.0, 1, 2, 3, 4\n", GeometryKind::Box).expect("valid test input");
+        assert_eq!((v[0].frame, v[0].id, v[0].confidence), (7, 2, 1.0));
+    }
+
+    #[test]
+    fn reads_ground_plane_points_from_x_y() {
+        let v = parse("1,1,-1,-1,-1,-1,1,2.5,-0.75,0\n", GeometryKind::Point)
+            .expect("valid test input");
+        assert_eq!(
+            v[0].geometry,
+            Geometry::Point(GroundPoint {
+                x_m: 2.5,
+                y_m: -0.75
+            })
+        );
+    }
+
+    #[test]
+    fn errors_name_file_and_line() {
+        let ok = "1,1,0,0,10,10,1,-1,-1,-1\n";
+        let cases: &[(String, GeometryKind, &str)] = &[
+            (
+                format!("{ok}1,2,0,0,10\n"),
+                GeometryKind::Box,
+                "runs/hyp.txt:2: 5 columns",
+            ),
+            (
+                format!("{ok}{ok}"),
+                GeometryKind::Box,
+                "runs/hyp.txt:2: frame 1 has id 1 a second time (first on line 1)",
+            ),
+            (
+                format!("{ok}\n1,x,0,0,10,10\n"),
+                GeometryKind::Box,
+                "runs/hyp.txt:3: column `id` is `x`, not an integer",
+            ),
+            (
+                "1,1.5,0,0,1,1\n".into(),
+                GeometryKind::Box,
+                "runs/hyp.txt:1: column `id` is `1.5`",
+            ),
+            (
+                "1,1,0,0,NaN,1\n".into(),
+                GeometryKind::Box,
+                "runs/hyp.txt:1: column `bb_width` is `NaN`, not a finite number",
+            ),
+            (
+                "1,1,0,0,1,inf\n".into(),
+                GeometryKind::Box,
+                "column `bb_height` is `inf`",
+            ),
+            (
+                "1,1,0,0,-3,1\n".into(),
+                GeometryKind::Box,
+                "runs/hyp.txt:1: `bb_width` is -3; a box size cannot be negative",
+            ),
+            (
+                "1,1,0,0,1,1,,-1,-1,-1\n".into(),
+                GeometryKind::Box,
+                "runs/hyp.txt:1: column `conf` is ``",
+            ),
+            (
+                "1,1,0,0,1,1,1,2,3,4,5\n".into(),
+                GeometryKind::Box,
+                "runs/hyp.txt:1: 11 columns",
+            ),
+            (
+                "1,1,0,0,1,1,1\n".into(),
+                GeometryKind::Point,
+                "runs/hyp.txt:1: 7 columns; a MOTChallenge row has 9 or 10",
+            ),
+            (
+                "1,1,0,0,1,1,1,a,0\n".into(),
+                GeometryKind::Point,
+                "runs/hyp.txt:1: column `x` is `a`",
+            ),
+            (
+                "1,1,0,0,9,9,1,-1,-1,-1\n2,1,0,0,9,9,1,-1,-1,-1\n".into(),
+                GeometryKind::Point,
+                "runs/hyp.txt: no row has ground-plane coordinates",
+            ),
+            (
+                "99999999999999999999,1,0,0,1,1\n".into(),
+                GeometryKind::Box,
+                "column `frame` is `99999999999999999999`",
+            ),
+        ];
+        for (text, kind, want) in cases {
+            let got = err(text, *kind);
+            assert!(got.contains(want), "{text:?}: got `{got}`, want `{want}`");
+        }
+    }
+
+    #[test]
+    fn write_then_parse_round_trips() {
+        let obs = vec![
+            Observation {
+                frame: 3,
+                id: -2,
+                geometry: Geometry::Box(BoxPx {
+                    left_px: 0.1 + 0.2,
+                    top_px: -5.0,
+                    width_px: 1e-300,
+                    height_px: 123456.789,
+                }),
+                confidence: 0.25,
+            },
+            Observation {
+                frame: 4,
+                id: 7,
+                geometry: Geometry::Box(BoxPx {
+                    left_px: 1.0,
+                    top_px: 2.0,
+                    width_px: 3.0,
+                    height_px: 4.0,
+                }),
+                confidence: 1.0,
+            },
+        ];
+        let text = write_motchallenge(&obs);
+        assert_eq!(
+            parse(&text, GeometryKind::Box).expect("valid test input"),
+            obs
+        );
+        let pts = vec![Observation {
+            frame: 1,
+            id: 1,
+            geometry: Geometry::Point(GroundPoint {
+                x_m: 1.0 / 3.0,
+                y_m: -2.0,
+            }),
+            confidence: 1.0,
+        }];
+        let text = write_motchallenge(&pts);
+        assert_eq!(text, "1,1,-1,-1,-1,-1,1,0.3333333333333333,-2,-1\n");
+        assert_eq!(
+            parse(&text, GeometryKind::Point).expect("valid test input"),
+            pts
+        );
+    }
+}
