@@ -120,7 +120,7 @@ mod tests {
         assert!(r[0].is_infinite() && r[180].is_infinite());
         // a beam 1° off centre grazes the cylinder: hits at √(3² ...) or misses, never less than 2.9
         assert!(r[89] >= 2.9 - 1e-6);
-        // pitched 10° down, a laser 0.3 m up sees the floor at 0.3 / tan 10° = 1.70 m
+        // pitched 10° down, a laser 0.3 m up sees the floor at a slant range of 0.3 / sin 10° = 1.728 m
         let floor = [Primitive::new(
             Shape::Plane { z: 0.0, up: true },
             Material::flat([0, 0, 0]),
@@ -132,7 +132,7 @@ mod tests {
         );
         let (r, _) = scan(&spec, &pitched, &[&floor], 1);
         assert!(
-            (f64::from(r[90]) - 0.3 / 10f64.to_radians().tan()).abs() < 1e-4,
+            (f64::from(r[90]) - 0.3 / 10f64.to_radians().sin()).abs() < 1e-4,
             "{}",
             r[90]
         );

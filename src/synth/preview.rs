@@ -128,7 +128,9 @@ pub fn sheet(name: &str, p: &PreviewData) -> Result<Vec<u8>, crate::report::figu
             row_w = 0;
         }
         row_w += t.width();
-        rows.last_mut().map(|r| r.push(t));
+        if let Some(r) = rows.last_mut() {
+            r.push(t);
+        }
     }
     let width = rows
         .iter()

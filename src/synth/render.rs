@@ -535,56 +535,97 @@ mod tests {
         }
     }
 
-    /// A small sphere at a known point is painted exactly where the model projects it.
+    /// A small sphere at a known point is painted exactly where each camera model projects it.
     #[test]
     fn a_sphere_lands_on_its_projected_pixel() {
+        use crate::geometry::camera::{ConicalMirror, Paracatadioptric};
+        use nalgebra::{Translation3, UnitQuaternion};
         let world = empty_world();
-        let model = CameraModel::Pinhole(Pinhole {
-            dist: [-0.2, 0.05, 0.0, 0.0, 0.0],
-            ..Pinhole::from_fov(160, 120, 70.0)
-        });
-        let pose = look_at(Point3::new(0.0, 0.0, 2.0), Point3::new(4.0, 1.0, 0.5));
-        let target = Point3::new(4.3, 1.6, 0.9);
-        let ball = Primitive::new(
-            Shape::Ellipsoid {
-                center: target,
-                radii: Vector3::new(0.05, 0.05, 0.05),
-                yaw: 0.0,
-            },
-            Material::flat([255, 0, 0]),
-            1007,
-        );
-        for fixed in [false, true] {
-            let cam = Camera::new("c", model.clone(), 0.0, fixed.then_some((pose, &world)), 0);
-            let f = cam.render(&FrameInput {
-                world: &world,
-                dynamic: std::slice::from_ref(&ball),
-                shadows: &[],
-                t: 0.0,
-                pose,
-                noise_key: 1,
-            });
-            let px = model.project(&(pose.inverse() * target)).expect("visible");
-            let hits: Vec<(usize, usize)> = f
-                .ids
-                .iter()
-                .enumerate()
-                .filter(|(_, id)| **id == 1007)
-                .map(|(i, _)| (i % 160, i / 160))
-                .collect();
-            assert!(!hits.is_empty());
-            let (mx, my) = hits.iter().fold((0.0, 0.0), |a, h| {
-                (a.0 + h.0 as f64 + 0.5, a.1 + h.1 as f64 + 0.5)
-            });
-            let (mx, my) = (mx / hits.len() as f64, my / hits.len() as f64);
-            assert!(
-                (mx - px.x).abs() < 0.75 && (my - px.y).abs() < 0.75,
-                "centroid ({mx}, {my}) vs projection {px}"
+        let down = |z: f64| {
+            Isometry3::from_parts(
+                Translation3::new(0.0, 0.0, z),
+                UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.0),
+            )
+        };
+        let cases = [
+            (
+                CameraModel::Pinhole(Pinhole {
+                    dist: [-0.2, 0.05, 0.0, 0.0, 0.0],
+                    ..Pinhole::from_fov(160, 120, 70.0)
+                }),
+                look_at(Point3::new(0.0, 0.0, 2.0), Point3::new(4.0, 1.0, 0.5)),
+                Point3::new(4.3, 1.6, 0.9),
+            ),
+            (
+                CameraModel::Paracatadioptric(Paracatadioptric {
+                    width: 160,
+                    height: 160,
+                    xc: 80.0,
+                    yc: 80.0,
+                    f: 36.0,
+                    r_min: 6.0,
+                    r_max: 78.0,
+                }),
+                down(1.2),
+                Point3::new(2.0, 1.0, 0.4),
+            ),
+            (
+                CameraModel::ConicalMirror(ConicalMirror {
+                    width: 160,
+                    height: 160,
+                    xc: 80.0,
+                    yc: 80.0,
+                    f: 50.0,
+                    d: 0.05,
+                    alpha: 77.5f64.to_radians(),
+                    z_top: 0.076,
+                }),
+                Isometry3::translation(0.0, 0.0, 1.7),
+                Point3::new(2.0, -1.0, 0.6),
+            ),
+        ];
+        for (model, pose, target) in cases {
+            let (w, _) = model.size();
+            let ball = Primitive::new(
+                Shape::Ellipsoid {
+                    center: target,
+                    radii: Vector3::new(0.05, 0.05, 0.05),
+                    yaw: 0.0,
+                },
+                Material::flat([255, 0, 0]),
+                1007,
             );
-            // and it is red
-            let i = hits[hits.len() / 2];
-            let k = 3 * (i.1 * 160 + i.0);
-            assert!(f.rgb[k] > 150 && f.rgb[k + 1] < 30);
+            for fixed in [false, true] {
+                let cam = Camera::new("c", model.clone(), 0.0, fixed.then_some((pose, &world)), 0);
+                let f = cam.render(&FrameInput {
+                    world: &world,
+                    dynamic: std::slice::from_ref(&ball),
+                    shadows: &[],
+                    t: 0.0,
+                    pose,
+                    noise_key: 1,
+                });
+                let px = model.project(&(pose.inverse() * target)).expect("visible");
+                let hits: Vec<(usize, usize)> = f
+                    .ids
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, id)| **id == 1007)
+                    .map(|(i, _)| (i % w as usize, i / w as usize))
+                    .collect();
+                assert!(!hits.is_empty(), "{model:?}: sphere not painted");
+                let (mx, my) = hits.iter().fold((0.0, 0.0), |a, h| {
+                    (a.0 + h.0 as f64 + 0.5, a.1 + h.1 as f64 + 0.5)
+                });
+                let (mx, my) = (mx / hits.len() as f64, my / hits.len() as f64);
+                assert!(
+                    (mx - px.x).abs() < 0.75 && (my - px.y).abs() < 0.75,
+                    "{model:?}: centroid ({mx}, {my}) vs projection {px}"
+                );
+                let i = hits[hits.len() / 2];
+                let k = 3 * (i.1 * w as usize + i.0);
+                assert!(f.rgb[k] > 150 && f.rgb[k + 1] < 30, "red");
+            }
         }
     }
 }

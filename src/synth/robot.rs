@@ -223,7 +223,7 @@ pub fn odometry(
     let (mut x, mut y, mut yaw) = (0.0f64, 0.0f64, 0.0f64);
     let dt = 1.0 / rate;
     let mut t = 0.0;
-    while t <= duration + 1e-9 {
+    while t < duration - 1e-9 {
         let s = track.state(t);
         let v = s.v * (1.0 + bias) + 0.2 * dv.sample(&mut r) * s.v.abs();
         let w = s.w + dw.sample(&mut r);
@@ -277,8 +277,8 @@ mod tests {
         assert!(max_pitch.to_degrees() > 3.0, "{}", max_pitch.to_degrees());
         // noise-free odometry reproduces the true path
         let odo = odometry(&tr, [0.0, 0.0], 50.0, 10.0, 3, 0);
-        let (_, [ox, oy, _], _, _) = odo[odo.len() - 1];
-        let truth = tr.state(10.0);
+        let (t_last, [ox, oy, _], _, _) = odo[odo.len() - 1];
+        let truth = tr.state(t_last);
         assert!((ox - truth.x).abs() < 0.05 && (oy - truth.y).abs() < 0.05);
     }
 }

@@ -76,26 +76,15 @@ pub enum WorldKind {
     Outdoor,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum TextureSpec {
+    #[default]
     Flat,
     /// Square tiles of `size` m, alternate tiles darkened by `contrast`.
-    Tiles {
-        size: f64,
-        contrast: f64,
-    },
+    Tiles { size: f64, contrast: f64 },
     /// Smooth random variation of relative amplitude `amp` at scale `scale` m.
-    Noise {
-        scale: f64,
-        amp: f64,
-    },
-}
-
-impl Default for TextureSpec {
-    fn default() -> Self {
-        TextureSpec::Flat
-    }
+    Noise { scale: f64, amp: f64 },
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -60,7 +60,7 @@ pub struct Actor {
 
 enum SensorRuntime {
     Camera {
-        cam: Camera,
+        cam: Box<Camera>,
         frame_id: String,
         /// `base_from_sensor` for robot-mounted, `map_from_sensor` for fixed.
         mount: Isometry3<f64>,
@@ -89,11 +89,13 @@ impl SensorRuntime {
     }
 }
 
+/// One camera's frame for the preview and what it saw of each person `(id, view)`.
+pub type PreviewCamera = (String, RgbImage, Vec<(u32, CameraView)>);
+
 /// What the preview sheet shows: one instant of the session.
 pub struct PreviewData {
     pub t: f64,
-    /// Per camera: its frame and what it saw of each person `(id, view)`.
-    pub cameras: Vec<(String, RgbImage, Vec<(u32, CameraView)>)>,
+    pub cameras: Vec<PreviewCamera>,
     /// Laser returns in the map frame.
     pub scan_points: Vec<[f64; 2]>,
     pub people: Vec<PersonTruth>,
@@ -261,8 +263,8 @@ fn actors(
     if let Some(c) = &s.crowd {
         let mut r = rng::stream(s.scenario.seed, "crowd", session);
         let dur = s.scenario.duration_s;
-        let mut next_id = s.people.iter().map(|p| p.id).max().unwrap_or(0) + 1;
-        for k in 0..c.count {
+        let first_id = s.people.iter().map(|p| p.id).max().unwrap_or(0) + 1;
+        for (k, next_id) in (0..c.count).zip(first_id..) {
             let height = c.height[0] + r.random::<f64>() * (c.height[1] - c.height[0]);
             let body = Body {
                 id: next_id,
@@ -279,7 +281,6 @@ fn actors(
                 ],
                 hat: None,
             };
-            next_id += 1;
             let stay = c.stay_s[0] + r.random::<f64>() * (c.stay_s[1] - c.stay_s[0]);
             // spread arrivals over the session
             let enter = (dur - stay.min(dur)).max(0.0) * (k as f64 + r.random::<f64>())
@@ -657,7 +658,7 @@ pub fn write_session(
                     None
                 };
                 sensors.push(SensorRuntime::Camera {
-                    cam,
+                    cam: Box::new(cam),
                     frame_id: camera.name.clone(),
                     mount: pose,
                     on_robot,
@@ -754,7 +755,7 @@ pub fn write_session(
     let mut k = 0u64;
     loop {
         let t = k as f64 * imu_dt;
-        if t > dur {
+        if t >= dur {
             break;
         }
         let st = robot_track.state(t);
@@ -791,7 +792,14 @@ pub fn write_session(
     let mut events: Vec<(u64, usize, u64)> = Vec::new();
     for (i, sen) in sensors.iter().enumerate() {
         let period = 1.0 / sen.rate();
-        let phase = f64::from(rng::unit(rng::hash(seed, &[0x9a5e, i as u64]))) * period.min(0.02);
+        // cameras are triggered together (as multi-camera rigs are); lasers free-run with a
+        // small offset
+        let phase = match sen {
+            SensorRuntime::Camera { .. } => 0.0,
+            SensorRuntime::Laser { .. } => {
+                f64::from(rng::unit(rng::hash(seed, &[0x9a5e, i as u64]))) * period.min(0.02)
+            }
+        };
         let mut n = 0u64;
         loop {
             let t = phase + n as f64 * period;

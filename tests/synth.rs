@@ -1,0 +1,201 @@
+//! The synthesizer end to end on a tiny scenario: deterministic bytes whatever the thread
+//! count, logs that read back through our reader with every topic decoding, ground truth that
+//! agrees with the images and the laser.
+
+use std::path::{Path, PathBuf};
+
+use peopletrack::groundtruth::PeopleFrame;
+use peopletrack::log::msgs::{CompressedImage, Image, LaserScan};
+use peopletrack::log::{Decoders, SessionLog, read_topic};
+use peopletrack::synth::{SynthOptions, synthesize};
+
+fn scenario() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny_scenario.toml")
+}
+
+fn synth_into(dir: &Path, threads: usize) -> Vec<PathBuf> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("pool");
+    pool.install(|| {
+        synthesize(
+            &scenario(),
+            &SynthOptions {
+                profile: "quick".into(),
+                out: Some(dir.to_path_buf()),
+                preview_root: Some(dir.join("preview")),
+                progress: false,
+            },
+        )
+        .expect("synthesizes")
+        .sessions
+    })
+}
+
+#[test]
+fn same_scenario_and_seed_give_identical_bytes_whatever_the_thread_count() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let a = synth_into(&dir.path().join("one"), 1);
+    let b = synth_into(&dir.path().join("three"), 3);
+    assert_eq!(a.len(), 2);
+    for (x, y) in a.iter().zip(&b) {
+        let (bx, by) = (
+            std::fs::read(x).expect("read"),
+            std::fs::read(y).expect("read"),
+        );
+        assert!(bx.len() > 10_000);
+        assert!(bx == by, "{} differs between 1 and 3 threads", x.display());
+    }
+    // sessions differ from each other (different session seeds)
+    assert_ne!(
+        std::fs::read(&a[0]).expect("a0"),
+        std::fs::read(&a[1]).expect("a1")
+    );
+    assert!(dir.path().join("one/preview/tiny/preview.png").exists());
+}
+
+#[test]
+fn logs_read_back_with_every_topic_decoding() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let sessions = synth_into(dir.path(), 2);
+    let log = SessionLog::open(&sessions[0]).expect("opens");
+    let mut dec = Decoders::new();
+    let mut counts = std::collections::BTreeMap::new();
+    for m in log.messages().expect("stream") {
+        let m = m.expect("message");
+        dec.value(&log, &m).unwrap_or_else(|e| panic!("{e}"));
+        *counts.entry(m.topic().to_string()).or_insert(0) += 1;
+    }
+    assert_eq!(counts["/cam_0/image_raw"], 10);
+    assert_eq!(counts["/cam_0/ground_truth_mask"], 10);
+    assert_eq!(counts["/omni_para/image_raw/compressed"], 5);
+    assert_eq!(counts["/omni_cone/image_raw/compressed"], 5);
+    assert_eq!(counts["/scan"], 10);
+    assert_eq!(counts["/odom"], 50);
+    assert_eq!(counts["/tf_static"], 1);
+    assert!(counts["/ground_truth/people"] >= 10);
+    assert_eq!(
+        log.summary()
+            .metadata
+            .iter()
+            .find(|m| m.name == "peopletrack.scenario")
+            .map(|m| m.entries["seed"].as_str()),
+        Some("42")
+    );
+    // images decode, and the JPEG camera too
+    let (_, img) = read_topic::<Image>(&log, "/cam_0/image_raw")
+        .expect("t")
+        .next()
+        .expect("1")
+        .expect("ok");
+    assert_eq!(
+        (img.width, img.height, img.encoding.as_str()),
+        (64, 48, "rgb8")
+    );
+    let (_, jpg) = read_topic::<CompressedImage>(&log, "/omni_cone/image_raw/compressed")
+        .expect("t")
+        .next()
+        .expect("1")
+        .expect("ok");
+    let decoded = peopletrack::log::image::decode_compressed(&jpg).expect("jpeg decodes");
+    assert_eq!((decoded.width(), decoded.height()), (64, 64));
+}
+
+#[test]
+fn ground_truth_agrees_with_the_mask_and_the_laser() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let sessions = synth_into(dir.path(), 2);
+    let log = SessionLog::open(&sessions[0]).expect("opens");
+    let masks: Vec<_> = read_topic::<Image>(&log, "/cam_0/ground_truth_mask")
+        .expect("masks")
+        .map(|r| r.expect("ok"))
+        .collect();
+    let mut gts: Vec<(peopletrack::Nanos, PeopleFrame)> = Vec::new();
+    for m in log.messages_on(&["/ground_truth/people"]).expect("gt") {
+        let m = m.expect("ok");
+        gts.push((
+            m.log_time,
+            serde_json::from_slice(&m.data).expect("valid ground truth"),
+        ));
+    }
+    let mut checked = 0;
+    for (_, mask) in &masks {
+        let stamp = mask.header.stamp.nanos().expect("stamp");
+        let Some((_, gt)) = gts.iter().find(|(t, _)| *t == stamp) else {
+            continue;
+        };
+        let Some(view) = gt
+            .people
+            .iter()
+            .flat_map(|p| &p.cameras)
+            .find(|v| v.camera == "cam_0")
+        else {
+            continue;
+        };
+        // the box is the extent of the mask's foreground pixels
+        let fg: Vec<(u32, u32)> = mask
+            .data
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| **v == 255)
+            .map(|(i, _)| ((i % 64) as u32, (i / 64) as u32))
+            .collect();
+        match view.bbox {
+            Some([x0, y0, x1, y1]) => {
+                let (mx0, my0) = (
+                    fg.iter().map(|p| p.0).min().expect("fg"),
+                    fg.iter().map(|p| p.1).min().expect("fg"),
+                );
+                let (mx1, my1) = (
+                    fg.iter().map(|p| p.0).max().expect("fg"),
+                    fg.iter().map(|p| p.1).max().expect("fg"),
+                );
+                assert_eq!(
+                    [x0, y0, x1, y1],
+                    [
+                        f64::from(mx0),
+                        f64::from(my0),
+                        f64::from(mx1 + 1),
+                        f64::from(my1 + 1)
+                    ]
+                );
+                checked += 1;
+            }
+            None => assert!(fg.is_empty()),
+        }
+    }
+    assert!(
+        checked >= 5,
+        "only {checked} frames with the person in view"
+    );
+    // the laser sees the person's legs where the ground truth puts them
+    let scans: Vec<_> = read_topic::<LaserScan>(&log, "/scan")
+        .expect("scan")
+        .map(|r| r.expect("ok"))
+        .collect();
+    let mut near = 0;
+    for (_, s) in &scans {
+        let stamp = s.header.stamp.nanos().expect("stamp");
+        let Some((_, gt)) = gts.iter().find(|(t, _)| *t == stamp) else {
+            continue;
+        };
+        let Some(p) = gt.people.first() else { continue };
+        // laser at (2.5, 0.3) + 0.1 forward (robot faces +y), height 0.3: beam angle 0 is +y
+        let (lx, ly) = (2.5, 0.4);
+        for leg in p.legs {
+            let (dx, dy) = (leg[0] - lx, leg[1] - ly);
+            let bearing = -dx.atan2(dy); // angle from +y towards +x is clockwise = negative
+            let k = ((bearing - f64::from(s.angle_min)) / f64::from(s.angle_increment)).round()
+                as usize;
+            let expect = dx.hypot(dy) - p.leg_radius;
+            if let Some(r) = s.ranges.get(k)
+                && r.is_finite()
+                && (f64::from(*r) - expect).abs() < 0.15
+            {
+                near += 1;
+            }
+        }
+    }
+    assert!(near >= 8, "legs seen where expected in only {near} beams");
+}
