@@ -45,6 +45,7 @@ bench: $(VENV)/ok
 	$(CARGO) bench --bench read_decode -- --noplot
 	$(VENV)/bin/python tools/bench_python_read.py target/bench-data/python_read.json
 	$(VENV)/bin/python tools/bench_compare.py target/criterion target/bench-data/python_read.json
+	$(MAKE) bench-mot
 
 # py-motmetrics 1.4.0 calls np.asfarray, which numpy 2 removed: pin the last numpy 1 stack.
 $(VENV)/mot-ok:
