@@ -12,5 +12,6 @@ pub mod pipelines;
 pub mod report;
 pub mod run;
 pub mod time;
+pub mod vision;
 
 pub use time::Nanos;
