@@ -32,8 +32,8 @@
 //! As in OpenCV, a learning rate ≥ 1 restarts the model on that frame.
 //!
 //! **Speed.** The state is structure-of-arrays in groups of 8 neighbouring pixels, updated
-//! in lock-step with lane masks (`kernel`), so the compiler vectorises the recursion; AVX2 is
-//! chosen at run time when present. Rows run in parallel with rayon; pixels never interact,
+//! in lock-step with lane masks (`kernel`): one SIMD instruction per step of the recursion;
+//! AVX2 is chosen at run time when present, plain arrays otherwise. Rows run in parallel with rayon; pixels never interact,
 //! so the masks are identical for any thread count.
 //!
 //! **Saved state** ([`AdaptiveGmm::save`] / [`AdaptiveGmm::load`]; OpenCV cannot do this),
@@ -65,7 +65,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::view::ImageView;
-use kernel::{Coeffs, Isa, LANES};
+use kernel::{Coeffs, Isa, LANES, Lanes, Layout};
 
 /// Mask value of a background pixel.
 pub const BACKGROUND: u8 = 0;
@@ -251,10 +251,17 @@ struct Shape {
     channels: usize,
 }
 
-impl Shape {
-    fn groups_per_row(&self) -> usize {
-        self.width.div_ceil(LANES)
-    }
+/// Where one pixel's mixture lives in [`AdaptiveGmm::state`].
+#[derive(Debug, Clone, Copy)]
+struct PixelAt {
+    /// First lane vector of the pixel's row.
+    row_base: usize,
+    layout: Layout,
+    /// Group within the row.
+    g: usize,
+    /// Index of the group in [`AdaptiveGmm::modes`].
+    group: usize,
+    lane: usize,
 }
 
 /// Zivkovic's adaptive GMM background subtractor (or, with
@@ -265,9 +272,9 @@ pub struct AdaptiveGmm {
     /// Frames seen since the model was (re)initialised.
     frames: u64,
     shape: Option<Shape>,
-    /// Per row, `groups_per_row` blocks of `n_mixtures * (2 + channels)` lane vectors.
-    state: Vec<[f32; LANES]>,
-    /// Per row, `groups_per_row` lane vectors of component counts.
+    /// Rows of [`Layout::row_len`] lane vectors (see `kernel` for the layout).
+    state: Vec<Lanes>,
+    /// Per row, one lane vector of component counts per group.
     modes: Vec<[u8; LANES]>,
 }
 
@@ -379,8 +386,8 @@ impl AdaptiveGmm {
         self.frames += 1;
         let co = self.coeffs(alpha);
 
-        let groups = shape.groups_per_row();
-        let row_state = groups * self.params.n_mixtures * (2 + shape.channels);
+        let layout = self.layout(shape);
+        let (groups, row_state) = (layout.groups, layout.row_len());
         let row_bytes = shape.width * shape.channels;
         self.state
             .par_chunks_mut(row_state)
@@ -394,11 +401,11 @@ impl AdaptiveGmm {
     }
 
     fn init(&mut self, shape: Shape) {
-        let groups = shape.groups_per_row() * shape.height;
+        let layout = self.layout(shape);
         self.frames = 0;
         self.shape = Some(shape);
-        self.state = vec![[0.0; LANES]; groups * self.params.n_mixtures * (2 + shape.channels)];
-        self.modes = vec![[0; LANES]; groups];
+        self.state = vec![[0.0; LANES]; layout.row_len() * shape.height];
+        self.modes = vec![[0; LANES]; layout.groups * shape.height];
     }
 
     /// The per-frame constants, rounded to `f32` where and as OpenCV rounds them.
@@ -422,11 +429,33 @@ impl AdaptiveGmm {
         }
     }
 
-    /// Where pixel `(x, y)` lives: (index of its group's first lane vector, group, lane).
-    fn locate(&self, shape: Shape, x: usize, y: usize) -> (usize, usize, usize) {
-        let group = y * shape.groups_per_row() + x / LANES;
-        let block = self.params.n_mixtures * (2 + shape.channels);
-        (group * block, group, x % LANES)
+    fn layout(&self, shape: Shape) -> Layout {
+        Layout::new(shape.width, self.params.n_mixtures, shape.channels)
+    }
+
+    fn pixel_at(&self, shape: Shape, x: usize, y: usize) -> PixelAt {
+        let layout = self.layout(shape);
+        let g = x / LANES;
+        PixelAt {
+            row_base: y * layout.row_len(),
+            layout,
+            g,
+            group: y * layout.groups + g,
+            lane: x % LANES,
+        }
+    }
+
+    /// Field `f` (0 weight, 1 variance, 2.. mean) of component `k` of a pixel.
+    fn field(&self, p: PixelAt, k: usize, f: usize) -> f32 {
+        self.state[p.row_base + p.layout.index(p.g, k, f)][p.lane]
+    }
+
+    fn field_mut(&mut self, p: PixelAt, k: usize, f: usize) -> &mut f32 {
+        &mut self.state[p.row_base + p.layout.index(p.g, k, f)][p.lane]
+    }
+
+    fn count(&self, p: PixelAt) -> usize {
+        usize::from(self.modes[p.group][p.lane])
     }
 
     /// The components of pixel `(x, y)`, in weight order.
@@ -440,19 +469,16 @@ impl AdaptiveGmm {
                 height: shape.height,
             });
         }
-        let (base, group, lane) = self.locate(shape, x, y);
-        let stride = 2 + shape.channels;
-        let n = usize::from(self.modes[group][lane]);
-        Ok((0..n)
+        let p = self.pixel_at(shape, x, y);
+        Ok((0..self.count(p))
             .map(|k| {
-                let slot = &self.state[base + k * stride..base + (k + 1) * stride];
                 let mut mean = [0.0; 3];
                 for (c, m) in mean.iter_mut().enumerate().take(shape.channels) {
-                    *m = slot[2 + c][lane];
+                    *m = self.field(p, k, 2 + c);
                 }
                 Component {
-                    weight: slot[0][lane],
-                    variance: slot[1][lane],
+                    weight: self.field(p, k, 0),
+                    variance: self.field(p, k, 1),
                     mean,
                 }
             })
@@ -465,7 +491,7 @@ impl AdaptiveGmm {
         let Some(shape) = self.shape else {
             return Vec::new();
         };
-        let groups = shape.groups_per_row();
+        let groups = self.layout(shape).groups;
         let mut out = Vec::with_capacity(shape.width * shape.height);
         for row in self.modes.chunks_exact(groups) {
             out.extend(row.iter().flatten().take(shape.width));
@@ -481,15 +507,13 @@ impl AdaptiveGmm {
         let mut out = Vec::with_capacity(shape.width * shape.height * shape.channels);
         for y in 0..shape.height {
             for x in 0..shape.width {
-                let (base, group, lane) = self.locate(shape, x, y);
-                let stride = 2 + shape.channels;
+                let p = self.pixel_at(shape, x, y);
                 let mut sum = [0.0f32; 3];
                 let mut total = 0.0f32;
-                for k in 0..usize::from(self.modes[group][lane]) {
-                    let slot = &self.state[base + k * stride..base + (k + 1) * stride];
-                    let w = slot[0][lane];
+                for k in 0..self.count(p) {
+                    let w = self.field(p, k, 0);
                     for (c, s) in sum.iter_mut().enumerate().take(shape.channels) {
-                        *s += w * slot[2 + c][lane];
+                        *s += w * self.field(p, k, 2 + c);
                     }
                     total += w;
                     if total > self.params.background_ratio {
@@ -550,11 +574,13 @@ impl AdaptiveGmm {
         for y in 0..shape.height {
             buf.clear();
             for x in 0..shape.width {
-                let (base, group, lane) = self.locate(shape, x, y);
-                let n = self.modes[group][lane];
-                buf.push(n);
-                for v in &self.state[base..base + usize::from(n) * stride] {
-                    buf.extend_from_slice(&v[lane].to_le_bytes());
+                let px = self.pixel_at(shape, x, y);
+                let n = self.count(px);
+                buf.push(n as u8);
+                for k in 0..n {
+                    for f in 0..stride {
+                        buf.extend_from_slice(&self.field(px, k, f).to_le_bytes());
+                    }
                 }
             }
             out.write_all(&buf)?;
@@ -632,16 +658,18 @@ impl AdaptiveGmm {
         let stride = 2 + shape.channels;
         for y in 0..height {
             for x in 0..width {
-                let (base, group, lane) = model.locate(shape, x, y);
+                let px = model.pixel_at(shape, x, y);
                 let n = r.u8()?;
                 if usize::from(n) > n_mixtures {
                     return Err(bad_state(format!(
                         "pixel ({x}, {y}) has {n} components, more than {n_mixtures}"
                     )));
                 }
-                model.modes[group][lane] = n;
-                for v in &mut model.state[base..base + usize::from(n) * stride] {
-                    v[lane] = r.f32()?;
+                model.modes[px.group][px.lane] = n;
+                for k in 0..usize::from(n) {
+                    for f in 0..stride {
+                        *model.field_mut(px, k, f) = r.f32()?;
+                    }
                 }
             }
         }

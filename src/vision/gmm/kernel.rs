@@ -1,20 +1,28 @@
 //! The per-pixel update of the adaptive mixture, run on [`LANES`] neighbouring pixels in
-//! lock-step so that the compiler turns every step into one SIMD instruction.
+//! lock-step so that every step is one SIMD instruction.
 //!
 //! Each pixel follows exactly the scalar recursion of the paper as OpenCV orders it (see the
 //! parent module): the lanes differ only in which components exist, which one owns the sample
 //! and where it moves in the weight order, and those differences become lane masks and
 //! blends. No arithmetic is reordered or fused, so every lane computes bit for bit what the
-//! scalar per-pixel loop computes (the unit tests compare the two on random sequences).
+//! scalar per-pixel loop computes (the unit tests compare the two on random sequences, on
+//! every instruction set).
 //!
-//! State layout: a row of the image is `ceil(width / LANES)` groups; a group is `n_mix`
-//! component slots; a slot is `2 + C` lane vectors `[weight, variance, mean_0 .. mean_C-1]`,
-//! each `[f32; LANES]`. Slots of a group are contiguous, so a group whose pixels use few
-//! components touches only the start of its block. Lanes past the right edge of the image
-//! compute on zeros and are never read back.
+//! The kernel is written once against [`Simd`]; [`Portable`] implements it with arrays
+//! (any CPU), `Avx2` with AVX2 intrinsics (chosen at run time).
+//!
+//! State layout ([`Layout`]): each image row is `groups = ceil(width / LANES)` groups of
+//! pixels; within a row, component slot k of every group comes before slot k + 1
+//! (slot-major), and a slot is `2 + C` lane vectors `[weight, variance, mean_0 .. mean_C-1]`,
+//! each `[f32; LANES]`. Walking a row therefore reads one sequential stream per slot in use,
+//! and slots no pixel uses are never touched. Lanes past the right edge of the image compute
+//! on zeros and are never read back.
 
-/// Pixels updated together. Eight `f32` lanes fill one AVX register (two SSE registers).
+/// Pixels updated together: eight `f32` lanes fill one AVX register.
 pub(super) const LANES: usize = 8;
+
+/// One lane vector of state.
+pub(super) type Lanes = [f32; LANES];
 
 /// Per-frame constants of the update, already in the precision OpenCV uses (`f32`).
 #[derive(Debug, Clone, Copy)]
@@ -42,370 +50,575 @@ pub(super) struct Coeffs {
     pub n_mix: usize,
 }
 
-// ---------------------------------------------------------------------------------------
-// Lane vectors. Plain arrays with element-wise loops: LLVM maps each to one vector op.
+/// Where a row's state lives (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Layout {
+    /// Pixel groups per row.
+    pub groups: usize,
+    /// Component slots per pixel (M).
+    pub n_mix: usize,
+    /// Lane vectors per slot, `2 + channels`.
+    pub stride: usize,
+}
 
-#[derive(Clone, Copy)]
-struct F([f32; LANES]);
-
-/// Lane mask: every lane is 0 or `u32::MAX`.
-#[derive(Clone, Copy)]
-struct B([u32; LANES]);
-
-/// Per-lane unsigned counts (number of components).
-#[derive(Clone, Copy)]
-struct U([u32; LANES]);
-
-macro_rules! lanewise {
-    ($a:expr, $b:expr, |$x:ident, $y:ident| $e:expr) => {{
-        let (a, b) = ($a, $b);
-        let mut out = [Default::default(); LANES];
-        for l in 0..LANES {
-            let ($x, $y) = (a[l], b[l]);
-            out[l] = $e;
+impl Layout {
+    pub fn new(width: usize, n_mix: usize, channels: usize) -> Self {
+        Self {
+            groups: width.div_ceil(LANES),
+            n_mix,
+            stride: 2 + channels,
         }
-        out
-    }};
+    }
+    /// Lane vectors per row.
+    pub fn row_len(&self) -> usize {
+        self.groups * self.n_mix * self.stride
+    }
+    /// Index within its row of field `f` (0 weight, 1 variance, 2.. mean) of slot `k` of
+    /// group `g`.
+    #[inline(always)]
+    pub fn index(&self, g: usize, k: usize, f: usize) -> usize {
+        (k * self.groups + g) * self.stride + f
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// The SIMD vocabulary the kernel is written in.
+
+/// Eight-lane `f32` operations. Comparisons are ordered and quiet (false on NaN), like
+/// Rust's `<`; masks are all-ones or all-zeros per lane.
+pub(super) trait Simd: Copy {
+    type F: Copy;
+    type M: Copy;
+    fn splat(self, v: f32) -> Self::F;
+    fn load(self, v: &Lanes) -> Self::F;
+    fn store(self, v: &mut Lanes, x: Self::F);
+    fn add(self, a: Self::F, b: Self::F) -> Self::F;
+    fn sub(self, a: Self::F, b: Self::F) -> Self::F;
+    fn mul(self, a: Self::F, b: Self::F) -> Self::F;
+    fn div(self, a: Self::F, b: Self::F) -> Self::F;
+    fn abs(self, a: Self::F) -> Self::F;
+    fn lt(self, a: Self::F, b: Self::F) -> Self::M;
+    fn le(self, a: Self::F, b: Self::F) -> Self::M;
+    fn eq(self, a: Self::F, b: Self::F) -> Self::M;
+    fn and(self, a: Self::M, b: Self::M) -> Self::M;
+    fn or(self, a: Self::M, b: Self::M) -> Self::M;
+    /// `a & !b`.
+    fn and_not(self, a: Self::M, b: Self::M) -> Self::M;
+    fn none(self) -> Self::M;
+    fn all(self) -> Self::M;
+    /// One bit per lane (lane 0 in bit 0).
+    fn bits(self, m: Self::M) -> u32;
+    /// `if m { t } else { f }` per lane.
+    fn select(self, m: Self::M, t: Self::F, f: Self::F) -> Self::F;
+    /// Eight 8-bit pixels of `C` interleaved channels (`src.len() == LANES * C`) as one
+    /// vector per channel.
+    fn load_pixels<const C: usize>(self, src: &[u8]) -> [Self::F; C];
+    /// Component counts (small integers, exact in `f32`).
+    fn load_counts(self, c: &[u8; LANES]) -> Self::F;
+}
+
+/// Plain arrays; LLVM vectorises what it can. Runs everywhere.
+#[derive(Clone, Copy)]
+pub(super) struct Portable;
+
+#[inline(always)]
+fn lanes<T: Copy + Default, const N: usize>(f: impl Fn(usize) -> T) -> [T; N] {
+    let mut out = [T::default(); N];
+    for (l, o) in out.iter_mut().enumerate() {
+        *o = f(l);
+    }
+    out
 }
 
 #[inline(always)]
-fn mask(c: bool) -> u32 {
+fn flag(c: bool) -> u32 {
     if c { u32::MAX } else { 0 }
 }
 
-impl F {
+impl Simd for Portable {
+    type F = Lanes;
+    type M = [u32; LANES];
     #[inline(always)]
-    fn splat(v: f32) -> Self {
-        F([v; LANES])
+    fn splat(self, v: f32) -> Lanes {
+        [v; LANES]
     }
     #[inline(always)]
-    fn add(self, o: F) -> F {
-        F(lanewise!(self.0, o.0, |a, b| a + b))
+    fn load(self, v: &Lanes) -> Lanes {
+        *v
     }
     #[inline(always)]
-    fn sub(self, o: F) -> F {
-        F(lanewise!(self.0, o.0, |a, b| a - b))
+    fn store(self, v: &mut Lanes, x: Lanes) {
+        *v = x;
     }
     #[inline(always)]
-    fn mul(self, o: F) -> F {
-        F(lanewise!(self.0, o.0, |a, b| a * b))
+    fn add(self, a: Lanes, b: Lanes) -> Lanes {
+        lanes(|l| a[l] + b[l])
     }
     #[inline(always)]
-    fn div(self, o: F) -> F {
-        F(lanewise!(self.0, o.0, |a, b| a / b))
+    fn sub(self, a: Lanes, b: Lanes) -> Lanes {
+        lanes(|l| a[l] - b[l])
     }
     #[inline(always)]
-    fn lt(self, o: F) -> B {
-        B(lanewise!(self.0, o.0, |a, b| mask(a < b)))
+    fn mul(self, a: Lanes, b: Lanes) -> Lanes {
+        lanes(|l| a[l] * b[l])
     }
     #[inline(always)]
-    fn le(self, o: F) -> B {
-        B(lanewise!(self.0, o.0, |a, b| mask(a <= b)))
+    fn div(self, a: Lanes, b: Lanes) -> Lanes {
+        lanes(|l| a[l] / b[l])
     }
     #[inline(always)]
-    fn ge(self, o: F) -> B {
-        B(lanewise!(self.0, o.0, |a, b| mask(a >= b)))
+    fn abs(self, a: Lanes) -> Lanes {
+        lanes(|l| a[l].abs())
     }
     #[inline(always)]
-    fn gt(self, o: F) -> B {
-        B(lanewise!(self.0, o.0, |a, b| mask(a > b)))
+    fn lt(self, a: Lanes, b: Lanes) -> Self::M {
+        lanes(|l| flag(a[l] < b[l]))
     }
     #[inline(always)]
-    fn eq(self, o: F) -> B {
-        B(lanewise!(self.0, o.0, |a, b| mask(a == b)))
+    fn le(self, a: Lanes, b: Lanes) -> Self::M {
+        lanes(|l| flag(a[l] <= b[l]))
     }
     #[inline(always)]
-    fn abs(self) -> F {
-        F(lanewise!(self.0, self.0, |a, _b| f32::from_bits(
-            a.to_bits() & 0x7fff_ffff
-        )))
+    fn eq(self, a: Lanes, b: Lanes) -> Self::M {
+        lanes(|l| flag(a[l] == b[l]))
+    }
+    #[inline(always)]
+    fn and(self, a: Self::M, b: Self::M) -> Self::M {
+        lanes(|l| a[l] & b[l])
+    }
+    #[inline(always)]
+    fn or(self, a: Self::M, b: Self::M) -> Self::M {
+        lanes(|l| a[l] | b[l])
+    }
+    #[inline(always)]
+    fn and_not(self, a: Self::M, b: Self::M) -> Self::M {
+        lanes(|l| a[l] & !b[l])
+    }
+    #[inline(always)]
+    fn none(self) -> Self::M {
+        [0; LANES]
+    }
+    #[inline(always)]
+    fn all(self) -> Self::M {
+        [u32::MAX; LANES]
+    }
+    #[inline(always)]
+    fn bits(self, m: Self::M) -> u32 {
+        m.iter()
+            .enumerate()
+            .fold(0, |acc, (l, &v)| acc | ((v & 1) << l))
+    }
+    #[inline(always)]
+    fn select(self, m: Self::M, t: Lanes, f: Lanes) -> Lanes {
+        lanes(|l| f32::from_bits((t[l].to_bits() & m[l]) | (f[l].to_bits() & !m[l])))
+    }
+    #[inline(always)]
+    fn load_pixels<const C: usize>(self, src: &[u8]) -> [Lanes; C] {
+        let src = &src[..LANES * C];
+        std::array::from_fn(|c| lanes(|l| f32::from(src[l * C + c])))
+    }
+    #[inline(always)]
+    fn load_counts(self, c: &[u8; LANES]) -> Lanes {
+        lanes(|l| f32::from(c[l]))
     }
 }
 
-impl B {
-    const NONE: B = B([0; LANES]);
-    #[inline(always)]
-    fn and(self, o: B) -> B {
-        B(lanewise!(self.0, o.0, |a, b| a & b))
-    }
-    #[inline(always)]
-    fn or(self, o: B) -> B {
-        B(lanewise!(self.0, o.0, |a, b| a | b))
-    }
-    /// `self & !o`.
-    #[inline(always)]
-    fn and_not(self, o: B) -> B {
-        B(lanewise!(self.0, o.0, |a, b| a & !b))
-    }
-    #[inline(always)]
-    fn not(self) -> B {
-        B(lanewise!(self.0, self.0, |a, _b| !a))
-    }
-    #[inline(always)]
-    fn any(self) -> bool {
-        self.0.iter().fold(0, |acc, &m| acc | m) != 0
-    }
-    /// `if self { t } else { f }` per lane.
-    #[inline(always)]
-    fn select(self, t: F, f: F) -> F {
-        let mut out = [0.0; LANES];
-        for l in 0..LANES {
-            let m = self.0[l];
-            out[l] = f32::from_bits((t.0[l].to_bits() & m) | (f.0[l].to_bits() & !m));
-        }
-        F(out)
-    }
-    #[inline(always)]
-    fn select_u(self, t: U, f: U) -> U {
-        t.blend(self, f)
-    }
-}
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use std::arch::x86_64::*;
 
-impl U {
-    #[inline(always)]
-    fn blend(self, m: B, f: U) -> U {
-        let mut out = [0; LANES];
-        for l in 0..LANES {
-            out[l] = (self.0[l] & m.0[l]) | (f.0[l] & !m.0[l]);
+    use super::{LANES, Lanes, Simd};
+
+    /// AVX2 intrinsics. A value of this type exists only once AVX2 was detected at run
+    /// time (see [`Avx2::detect`]), which is what makes the `unsafe` calls below sound.
+    #[derive(Clone, Copy)]
+    pub(in crate::vision::gmm) struct Avx2(());
+
+    impl Avx2 {
+        pub fn detect() -> Option<Avx2> {
+            std::arch::is_x86_feature_detected!("avx2").then_some(Avx2(()))
         }
-        U(out)
     }
-    /// Lanes where `k < self`.
-    #[inline(always)]
-    fn above(self, k: u32) -> B {
-        B(lanewise!(self.0, self.0, |a, _b| mask(k < a)))
-    }
-    #[inline(always)]
-    fn eq(self, k: u32) -> B {
-        B(lanewise!(self.0, self.0, |a, _b| mask(a == k)))
-    }
-    #[inline(always)]
-    fn max(self) -> u32 {
-        self.0.iter().fold(0, |acc, &m| acc.max(m))
+
+    // SAFETY (every `unsafe` block in this impl): the intrinsics need AVX/AVX2, and an
+    // `Avx2` value is only made after `is_x86_feature_detected!("avx2")`; loads and stores
+    // go through references to `[f32; 8]`, whose size the 256-bit access matches.
+    impl Simd for Avx2 {
+        type F = __m256;
+        type M = __m256;
+        #[inline(always)]
+        fn splat(self, v: f32) -> __m256 {
+            unsafe { _mm256_set1_ps(v) }
+        }
+        #[inline(always)]
+        fn load(self, v: &Lanes) -> __m256 {
+            unsafe { _mm256_loadu_ps(v.as_ptr()) }
+        }
+        #[inline(always)]
+        fn store(self, v: &mut Lanes, x: __m256) {
+            unsafe { _mm256_storeu_ps(v.as_mut_ptr(), x) }
+        }
+        #[inline(always)]
+        fn add(self, a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_add_ps(a, b) }
+        }
+        #[inline(always)]
+        fn sub(self, a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_sub_ps(a, b) }
+        }
+        #[inline(always)]
+        fn mul(self, a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_mul_ps(a, b) }
+        }
+        #[inline(always)]
+        fn div(self, a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_div_ps(a, b) }
+        }
+        #[inline(always)]
+        fn abs(self, a: __m256) -> __m256 {
+            unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), a) }
+        }
+        #[inline(always)]
+        fn lt(self, a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_cmp_ps::<_CMP_LT_OQ>(a, b) }
+        }
+        #[inline(always)]
+        fn le(self, a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_cmp_ps::<_CMP_LE_OQ>(a, b) }
+        }
+        #[inline(always)]
+        fn eq(self, a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_cmp_ps::<_CMP_EQ_OQ>(a, b) }
+        }
+        #[inline(always)]
+        fn and(self, a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_and_ps(a, b) }
+        }
+        #[inline(always)]
+        fn or(self, a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_or_ps(a, b) }
+        }
+        #[inline(always)]
+        fn and_not(self, a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_andnot_ps(b, a) }
+        }
+        #[inline(always)]
+        fn none(self) -> __m256 {
+            unsafe { _mm256_setzero_ps() }
+        }
+        #[inline(always)]
+        fn all(self) -> __m256 {
+            unsafe { _mm256_castsi256_ps(_mm256_set1_epi32(-1)) }
+        }
+        #[inline(always)]
+        fn bits(self, m: __m256) -> u32 {
+            unsafe { _mm256_movemask_ps(m) as u32 }
+        }
+        #[inline(always)]
+        fn select(self, m: __m256, t: __m256, f: __m256) -> __m256 {
+            unsafe { _mm256_blendv_ps(f, t, m) }
+        }
+        #[inline(always)]
+        fn load_pixels<const C: usize>(self, src: &[u8]) -> [__m256; C] {
+            let src = &src[..LANES * C];
+            if C == 3 {
+                // 24 bytes: pshufb channel c's bytes (c, c+3, .., c+21) to the bottom of a
+                // 16-byte register from the two halves, OR them, widen to i32 and convert.
+                let mut lo = [0u8; 16];
+                let mut hi = [0u8; 16];
+                lo.copy_from_slice(&src[..16]);
+                hi[..8].copy_from_slice(&src[16..24]);
+                unsafe {
+                    let lo = _mm_loadu_si128(lo.as_ptr().cast());
+                    let hi = _mm_loadu_si128(hi.as_ptr().cast());
+                    std::array::from_fn(|c| {
+                        let (mut a, mut b) = ([-1i8; 16], [-1i8; 16]);
+                        for l in 0..LANES {
+                            let i = l * 3 + c;
+                            if i < 16 {
+                                a[l] = i as i8;
+                            } else {
+                                b[l] = (i - 16) as i8;
+                            }
+                        }
+                        let a = _mm_loadu_si128(a.as_ptr().cast());
+                        let b = _mm_loadu_si128(b.as_ptr().cast());
+                        let v = _mm_or_si128(_mm_shuffle_epi8(lo, a), _mm_shuffle_epi8(hi, b));
+                        _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(v))
+                    })
+                }
+            } else {
+                std::array::from_fn(|c| {
+                    let mut b = [0u8; 16];
+                    for l in 0..LANES {
+                        b[l] = src[l * C + c];
+                    }
+                    unsafe {
+                        let v = _mm_loadu_si128(b.as_ptr().cast());
+                        _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(v))
+                    }
+                })
+            }
+        }
+        #[inline(always)]
+        fn load_counts(self, c: &[u8; LANES]) -> __m256 {
+            unsafe {
+                let v = _mm_loadl_epi64(c.as_ptr().cast());
+                _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(v))
+            }
+        }
     }
 }
 
 // ---------------------------------------------------------------------------------------
 // One group of LANES pixels.
 
-/// Index of field `f` (0 weight, 1 variance, 2.. mean) of slot `k` in a group block.
-#[inline(always)]
-fn at<const C: usize>(k: usize, f: usize) -> usize {
-    k * (2 + C) + f
+/// A group's slots inside its row.
+struct Group<'a> {
+    row: &'a mut [Lanes],
+    layout: Layout,
+    g: usize,
 }
 
-/// Swap slots `i` and `i - 1` in the lanes of `m`.
-#[inline(always)]
-fn swap_down<const C: usize>(blk: &mut [[f32; LANES]], i: usize, m: B) {
-    for f in 0..2 + C {
-        let hi = F(blk[at::<C>(i, f)]);
-        let lo = F(blk[at::<C>(i - 1, f)]);
-        blk[at::<C>(i, f)] = m.select(lo, hi).0;
-        blk[at::<C>(i - 1, f)] = m.select(hi, lo).0;
+impl Group<'_> {
+    #[inline(always)]
+    fn at(&self, k: usize, f: usize) -> usize {
+        self.layout.index(self.g, k, f)
+    }
+    #[inline(always)]
+    fn get<S: Simd>(&self, s: S, k: usize, f: usize) -> S::F {
+        s.load(&self.row[self.at(k, f)])
+    }
+    #[inline(always)]
+    fn set<S: Simd>(&mut self, s: S, k: usize, f: usize, v: S::F) {
+        let i = self.at(k, f);
+        s.store(&mut self.row[i], v)
+    }
+    /// Swap slots `i` and `i - 1` in the lanes of `m`.
+    #[inline(always)]
+    fn swap_down<S: Simd>(&mut self, s: S, i: usize, m: S::M) {
+        for f in 0..self.layout.stride {
+            let hi = self.get(s, i, f);
+            let lo = self.get(s, i - 1, f);
+            self.set(s, i, f, s.select(m, lo, hi));
+            self.set(s, i - 1, f, s.select(m, hi, lo));
+        }
     }
 }
 
-/// Update one group with the sample `x` (per channel) and return the mask bytes.
-///
-/// `blk` holds `n_mix * (2 + C)` lane vectors, `modes` the number of components per lane.
+/// `count > k` per lane, for counts held as exact small floats.
 #[inline(always)]
-fn update_group<const C: usize>(
-    blk: &mut [[f32; LANES]],
+fn above<S: Simd>(s: S, count: S::F, k: usize) -> S::M {
+    s.lt(s.splat(k as f32), count)
+}
+
+/// Update one group with the sample `x` (per channel); write the new component counts into
+/// `modes` and return the mask bytes.
+#[inline(always)]
+fn update_group<S: Simd, const C: usize>(
+    s: S,
+    grp: &mut Group<'_>,
     modes: &mut [u8; LANES],
-    x: &[F; C],
+    x: &[S::F; C],
     co: &Coeffs,
 ) -> [u8; LANES] {
-    let alpha = F::splat(co.alpha);
-    let alpha1 = F::splat(co.alpha1);
-    let prune = F::splat(co.prune);
-    let neg_prune = F::splat(-co.prune);
-    let tb = F::splat(co.tb);
-    let tg = F::splat(co.tg);
-    let big_tb = F::splat(co.background_ratio);
-    let zero = F::splat(0.0);
+    let alpha = s.splat(co.alpha);
+    let alpha1 = s.splat(co.alpha1);
+    let prune = s.splat(co.prune);
+    let neg_prune = s.splat(-co.prune);
+    let tb = s.splat(co.tb);
+    let tg = s.splat(co.tg);
+    let big_tb = s.splat(co.background_ratio);
+    let zero = s.splat(0.0);
+    let one = s.splat(1.0);
 
-    let mut nm = U(std::array::from_fn(|l| u32::from(modes[l])));
-    let mut fits = B::NONE;
-    let mut background = B::NONE;
+    let mut most = usize::from(modes.iter().copied().max().unwrap_or(0));
+    let mut nm = s.load_counts(modes);
+    let mut fits = s.none();
+    let mut background = s.none();
     let mut total = zero;
 
     // Eq. 4–6 and 14 for every existing component, in descending weight order; the first
-    // component within `tg` owns the sample (OpenCV's order, not "closest").
-    let visit = nm.max() as usize;
-    for k in 0..visit {
-        let active = nm.above(k as u32);
-        if !active.any() {
+    // component within `tg` owns the sample (OpenCV's order, not the closest one).
+    for k in 0..most {
+        let active = above(s, nm, k);
+        if s.bits(active) == 0 {
             break;
         }
-        let w_old = F(blk[at::<C>(k, 0)]);
-        let mut w = alpha1.mul(w_old).add(prune);
-        let open = active.and_not(fits);
-        let mut owner = B::NONE;
-        if open.any() {
-            let var = F(blk[at::<C>(k, 1)]);
-            let mut d = [zero; C];
-            for c in 0..C {
-                d[c] = F(blk[at::<C>(k, 2 + c)]).sub(x[c]);
-            }
-            let mut dist2 = d[0].mul(d[0]);
+        let w_old = grp.get(s, k, 0);
+        let mut w = s.add(s.mul(alpha1, w_old), prune);
+        let open = s.and_not(active, fits);
+        let mut owner = s.none();
+        if s.bits(open) != 0 {
+            let var = grp.get(s, k, 1);
+            let d: [S::F; C] = std::array::from_fn(|c| s.sub(grp.get(s, k, 2 + c), x[c]));
+            let mut dist2 = s.mul(d[0], d[0]);
             for dc in d.iter().skip(1) {
-                dist2 = dist2.add(dc.mul(*dc));
+                dist2 = s.add(dist2, s.mul(*dc, *dc));
             }
-            background = background.or(open.and(total.lt(big_tb)).and(dist2.lt(tb.mul(var))));
-            owner = open.and(dist2.lt(tg.mul(var)));
-            if owner.any() {
-                let w_own = w.add(alpha);
-                let kk = alpha.div(w_own);
-                for c in 0..C {
-                    let m = F(blk[at::<C>(k, 2 + c)]);
-                    blk[at::<C>(k, 2 + c)] = owner.select(m.sub(kk.mul(d[c])), m).0;
+            let in_background = s.and(s.lt(total, big_tb), s.lt(dist2, s.mul(tb, var)));
+            background = s.or(background, s.and(open, in_background));
+            owner = s.and(open, s.lt(dist2, s.mul(tg, var)));
+            if s.bits(owner) != 0 {
+                let w_own = s.add(w, alpha);
+                let r = s.div(alpha, w_own);
+                for (c, dc) in d.iter().enumerate() {
+                    let m = grp.get(s, k, 2 + c);
+                    grp.set(s, k, 2 + c, s.select(owner, s.sub(m, s.mul(r, *dc)), m));
                 }
-                let mut var_new = var.add(kk.mul(dist2.sub(var)));
-                var_new = var_new
-                    .lt(F::splat(co.var_min))
-                    .select(F::splat(co.var_min), var_new);
-                var_new = F::splat(co.var_max)
-                    .lt(var_new)
-                    .select(F::splat(co.var_max), var_new);
-                blk[at::<C>(k, 1)] = owner.select(var_new, var).0;
-                w = owner.select(w_own, w);
-                fits = fits.or(owner);
+                let mut var_new = s.add(var, s.mul(r, s.sub(dist2, var)));
+                let var_min = s.splat(co.var_min);
+                let var_max = s.splat(co.var_max);
+                var_new = s.select(s.lt(var_new, var_min), var_min, var_new);
+                var_new = s.select(s.lt(var_max, var_new), var_max, var_new);
+                grp.set(s, k, 1, s.select(owner, var_new, var));
+                w = s.select(owner, w_own, w);
+                fits = s.or(fits, owner);
             }
         }
         // Eq. 14's "drop the component when its weight goes negative", as OpenCV tests it.
-        let dropped = active.and(w.lt(neg_prune));
-        let w_kept = dropped.select(zero, w);
-        nm = dropped.select_u(U(std::array::from_fn(|l| nm.0[l].wrapping_sub(1))), nm);
-        blk[at::<C>(k, 0)] = active.select(w_kept, w_old).0;
+        let dropped = s.and(active, s.lt(w, neg_prune));
+        let w_kept = s.select(dropped, zero, w);
+        nm = s.sub(nm, s.select(dropped, one, zero));
+        grp.set(s, k, 0, s.select(active, w_kept, w_old));
         // The owner moves up past every component whose weight is not larger.
         let mut moving = owner;
         let mut i = k;
-        while i > 0 && moving.any() {
-            let up = F(blk[at::<C>(i - 1, 0)]);
-            let swap = moving.and(w.lt(up).not());
-            swap_down::<C>(blk, i, swap);
+        while i > 0 && s.bits(moving) != 0 {
+            let up = grp.get(s, i - 1, 0);
+            let swap = s.and_not(moving, s.lt(w, up));
+            grp.swap_down(s, i, swap);
             moving = swap;
             i -= 1;
         }
-        total = active.select(total.add(w_kept), total);
+        total = s.select(active, s.add(total, w_kept), total);
     }
 
-    // Normalise (eq. 14 is followed by a renormalisation).
-    let nonzero = total.abs().gt(F::splat(f32::EPSILON));
-    let inv = nonzero.select(F::splat(1.0).div(total), zero);
-    for k in 0..nm.max() as usize {
-        let live = nm.above(k as u32);
-        let w = F(blk[at::<C>(k, 0)]);
-        blk[at::<C>(k, 0)] = live.select(w.mul(inv), w).0;
+    // Renormalise the weights.
+    let nonzero = s.lt(s.splat(f32::EPSILON), s.abs(total));
+    let inv = s.select(nonzero, s.div(one, total), zero);
+    for k in 0..most {
+        let live = above(s, nm, k);
+        let w = grp.get(s, k, 0);
+        grp.set(s, k, 0, s.select(live, s.mul(w, inv), w));
     }
 
     // A sample no component owns starts a new one (replacing the weakest when full).
-    let new = if co.alpha > 0.0 { fits.not() } else { B::NONE };
-    if new.any() {
-        let full = nm.eq(co.n_mix as u32);
-        let nm_new = U(std::array::from_fn(|l| nm.0[l] + 1));
-        nm = new.and_not(full).select_u(nm_new, nm);
-        let only = new.and(nm.eq(1));
-        let w_new = only.select(F::splat(1.0), alpha);
-        for k in 0..co.n_mix {
-            let is_slot = new.and(nm.eq(k as u32 + 1));
-            let older = new.and_not(only).and(nm.above(k as u32 + 1));
-            let w = F(blk[at::<C>(k, 0)]);
-            blk[at::<C>(k, 0)] = is_slot.select(w_new, older.select(w.mul(alpha1), w)).0;
-            let v = F(blk[at::<C>(k, 1)]);
-            blk[at::<C>(k, 1)] = is_slot.select(F::splat(co.var_init), v).0;
-            for c in 0..C {
-                let m = F(blk[at::<C>(k, 2 + c)]);
-                blk[at::<C>(k, 2 + c)] = is_slot.select(x[c], m).0;
+    let new = if co.alpha > 0.0 {
+        s.and_not(s.all(), fits)
+    } else {
+        s.none()
+    };
+    if s.bits(new) != 0 {
+        let full = s.eq(nm, s.splat(co.n_mix as f32));
+        nm = s.add(nm, s.select(s.and_not(new, full), one, zero));
+        most = (most + 1).min(co.n_mix);
+        let only = s.and(new, s.eq(nm, one));
+        let w_new = s.select(only, one, alpha);
+        for k in 0..most {
+            let is_slot = s.and(new, s.eq(nm, s.splat(k as f32 + 1.0)));
+            let older = s.and(s.and_not(new, only), above(s, nm, k + 1));
+            let w = grp.get(s, k, 0);
+            let w = s.select(older, s.mul(w, alpha1), w);
+            grp.set(s, k, 0, s.select(is_slot, w_new, w));
+            let v = grp.get(s, k, 1);
+            grp.set(s, k, 1, s.select(is_slot, s.splat(co.var_init), v));
+            for (c, xc) in x.iter().enumerate() {
+                let m = grp.get(s, k, 2 + c);
+                grp.set(s, k, 2 + c, s.select(is_slot, *xc, m));
             }
         }
         let mut moving = new;
-        for i in (1..co.n_mix).rev() {
-            if !moving.any() {
+        for i in (1..most).rev() {
+            if s.bits(moving) == 0 {
                 break;
             }
-            let in_play = moving.and(nm.above(i as u32));
-            let up = F(blk[at::<C>(i - 1, 0)]);
-            let swap = in_play.and(alpha.lt(up).not());
-            swap_down::<C>(blk, i, swap);
-            moving = moving.and_not(in_play.and_not(swap));
+            let in_play = s.and(moving, above(s, nm, i));
+            let up = grp.get(s, i - 1, 0);
+            let swap = s.and_not(in_play, s.lt(alpha, up));
+            grp.swap_down(s, i, swap);
+            moving = s.and_not(moving, s.and_not(in_play, swap));
         }
     }
 
-    for l in 0..LANES {
-        modes[l] = nm.0[l] as u8;
+    let mut counts = [0.0f32; LANES];
+    s.store(&mut counts, nm);
+    for (m, c) in modes.iter_mut().zip(counts) {
+        *m = c as u8;
     }
 
-    let mut out = [0u8; LANES];
-    let foreground = background.not();
-    let shadow = if co.detect_shadows && foreground.any() {
-        detect_shadow::<C>(blk, nm, x, foreground, co)
+    let bg_bits = s.bits(background);
+    let shadow_bits = if co.detect_shadows && bg_bits != (1 << LANES) - 1 {
+        let foreground = s.and_not(s.all(), background);
+        s.bits(detect_shadow::<S, C>(s, grp, nm, most, x, foreground, co))
     } else {
-        B::NONE
+        0
     };
-    for l in 0..LANES {
-        out[l] = if background.0[l] != 0 {
+    std::array::from_fn(|l| {
+        if bg_bits >> l & 1 != 0 {
             0
-        } else if shadow.0[l] != 0 {
+        } else if shadow_bits >> l & 1 != 0 {
             co.shadow_value
         } else {
             255
-        };
-    }
-    out
+        }
+    })
 }
 
 /// The shadow test of Prati et al. as OpenCV's `detectShadowGMM` applies it: the sample is
 /// a shadow if, for one of the background components (eq. 8, in order), it is that
 /// component's mean scaled by a ∈ [τ, 1] and the colour distortion is within `tb`.
 #[inline(always)]
-fn detect_shadow<const C: usize>(
-    blk: &[[f32; LANES]],
-    nm: U,
-    x: &[F; C],
-    lanes: B,
+fn detect_shadow<S: Simd, const C: usize>(
+    s: S,
+    grp: &Group<'_>,
+    nm: S::F,
+    most: usize,
+    x: &[S::F; C],
+    lanes: S::M,
     co: &Coeffs,
-) -> B {
-    let zero = F::splat(0.0);
-    let tau = F::splat(co.tau);
-    let tb = F::splat(co.tb);
-    let big_tb = F::splat(co.background_ratio);
+) -> S::M {
+    let zero = s.splat(0.0);
+    let tau = s.splat(co.tau);
+    let tb = s.splat(co.tb);
+    let big_tb = s.splat(co.background_ratio);
     let mut searching = lanes;
-    let mut shadow = B::NONE;
+    let mut shadow = s.none();
     let mut weight_sum = zero;
-    for k in 0..co.n_mix {
-        let live = searching.and(nm.above(k as u32));
-        if !live.any() {
+    for k in 0..most {
+        let live = s.and(searching, above(s, nm, k));
+        if s.bits(live) == 0 {
             break;
         }
-        let mean: [F; C] = std::array::from_fn(|c| F(blk[at::<C>(k, 2 + c)]));
-        let mut num = x[0].mul(mean[0]);
-        let mut den = mean[0].mul(mean[0]);
+        let mean: [S::F; C] = std::array::from_fn(|c| grp.get(s, k, 2 + c));
+        let mut num = s.mul(x[0], mean[0]);
+        let mut den = s.mul(mean[0], mean[0]);
         for c in 1..C {
-            num = num.add(x[c].mul(mean[c]));
-            den = den.add(mean[c].mul(mean[c]));
+            num = s.add(num, s.mul(x[c], mean[c]));
+            den = s.add(den, s.mul(mean[c], mean[c]));
         }
-        let black = live.and(den.eq(zero));
-        searching = searching.and_not(black);
-        let live = live.and_not(black);
-        let darker = live.and(num.le(den)).and(num.ge(tau.mul(den)));
-        let mut hit = B::NONE;
-        if darker.any() {
-            let a = num.div(den);
-            let d0 = a.mul(mean[0]).sub(x[0]);
-            let mut dist2a = d0.mul(d0);
+        let black = s.and(live, s.eq(den, zero));
+        searching = s.and_not(searching, black);
+        let live = s.and_not(live, black);
+        let darker = s.and(live, s.and(s.le(num, den), s.le(s.mul(tau, den), num)));
+        let mut hit = s.none();
+        if s.bits(darker) != 0 {
+            let a = s.div(num, den);
+            let d0 = s.sub(s.mul(a, mean[0]), x[0]);
+            let mut dist2a = s.mul(d0, d0);
             for c in 1..C {
-                let dc = a.mul(mean[c]).sub(x[c]);
-                dist2a = dist2a.add(dc.mul(dc));
+                let dc = s.sub(s.mul(a, mean[c]), x[c]);
+                dist2a = s.add(dist2a, s.mul(dc, dc));
             }
-            let var = F(blk[at::<C>(k, 1)]);
-            hit = darker.and(dist2a.lt(tb.mul(var).mul(a).mul(a)));
-            shadow = shadow.or(hit);
-            searching = searching.and_not(hit);
+            let var = grp.get(s, k, 1);
+            let bound = s.mul(s.mul(s.mul(tb, var), a), a);
+            hit = s.and(darker, s.lt(dist2a, bound));
+            shadow = s.or(shadow, hit);
+            searching = s.and_not(searching, hit);
         }
-        let live = live.and_not(hit);
-        weight_sum = live.select(weight_sum.add(F(blk[at::<C>(k, 0)])), weight_sum);
-        searching = searching.and_not(live.and(weight_sum.gt(big_tb)));
+        let live = s.and_not(live, hit);
+        weight_sum = s.select(live, s.add(weight_sum, grp.get(s, k, 0)), weight_sum);
+        searching = s.and_not(searching, s.and(live, s.lt(big_tb, weight_sum)));
     }
     shadow
 }
@@ -413,94 +626,86 @@ fn detect_shadow<const C: usize>(
 // ---------------------------------------------------------------------------------------
 // Rows.
 
-/// Update one image row: `state` is the row's groups, `modes` one `[u8; LANES]` per group,
-/// `frame` the row's `width * C` bytes and `mask` its `width` output bytes.
+/// Update one image row: `state` is the row's [`Layout::row_len`] lane vectors, `modes` one
+/// `[u8; LANES]` per group, `frame` the row's `width * C` bytes and `mask` its `width`
+/// output bytes.
 #[inline(always)]
-fn update_row_generic<const C: usize>(
-    state: &mut [[f32; LANES]],
+fn update_row_generic<S: Simd, const C: usize>(
+    s: S,
+    state: &mut [Lanes],
     modes: &mut [[u8; LANES]],
     frame: &[u8],
     mask: &mut [u8],
     co: &Coeffs,
 ) {
     let width = mask.len();
-    let block = co.n_mix * (2 + C);
-    for (g, (blk, modes)) in state
-        .chunks_exact_mut(block)
-        .zip(modes.iter_mut())
-        .enumerate()
-    {
+    let layout = Layout::new(width, co.n_mix, C);
+    let mut grp = Group {
+        row: state,
+        layout,
+        g: 0,
+    };
+    for (g, modes) in modes.iter_mut().enumerate() {
+        grp.g = g;
         let x0 = g * LANES;
         let n = LANES.min(width - x0);
-        let mut x = [F::splat(0.0); C];
-        if n == LANES {
-            let src = &frame[x0 * C..(x0 + LANES) * C];
-            for l in 0..LANES {
-                for c in 0..C {
-                    x[c].0[l] = f32::from(src[l * C + c]);
-                }
-            }
+        let x = if n == LANES {
+            s.load_pixels::<C>(&frame[x0 * C..(x0 + LANES) * C])
         } else {
-            for l in 0..n {
-                for c in 0..C {
-                    x[c].0[l] = f32::from(frame[(x0 + l) * C + c]);
-                }
-            }
-        }
-        let out = update_group::<C>(blk, modes, &x, co);
+            let mut padded = [0u8; LANES * 3];
+            padded[..n * C].copy_from_slice(&frame[x0 * C..(x0 + n) * C]);
+            s.load_pixels::<C>(&padded)
+        };
+        let out = update_group::<S, C>(s, &mut grp, modes, &x, co);
         mask[x0..x0 + n].copy_from_slice(&out[..n]);
     }
 }
 
-fn update_row_portable(
-    channels: usize,
-    state: &mut [[f32; LANES]],
-    modes: &mut [[u8; LANES]],
-    frame: &[u8],
-    mask: &mut [u8],
-    co: &Coeffs,
-) {
-    if channels == 1 {
-        update_row_generic::<1>(state, modes, frame, mask, co)
-    } else {
-        update_row_generic::<3>(state, modes, frame, mask, co)
-    }
-}
-
-/// The same code compiled for AVX2: only the instruction selection differs, the IEEE
-/// operations and their order are the same, so the results are identical.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn update_row_avx2(
-    channels: usize,
-    state: &mut [[f32; LANES]],
-    modes: &mut [[u8; LANES]],
-    frame: &[u8],
-    mask: &mut [u8],
-    co: &Coeffs,
-) {
-    if channels == 1 {
-        update_row_generic::<1>(state, modes, frame, mask, co)
-    } else {
-        update_row_generic::<3>(state, modes, frame, mask, co)
-    }
-}
-
 /// Instruction set used for the rows, chosen once per frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy)]
 pub(super) enum Isa {
     Portable,
     #[cfg(target_arch = "x86_64")]
-    Avx2,
+    Avx2(avx2::Avx2),
 }
 
 impl Isa {
-    pub(super) fn detect() -> Isa {
+    pub fn detect() -> Isa {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            return Isa::Avx2;
+        if let Some(a) = avx2::Avx2::detect() {
+            return Isa::Avx2(a);
         }
         Isa::Portable
+    }
+
+    /// Every instruction set this CPU can run (the tests compare them).
+    #[cfg(test)]
+    pub fn available() -> Vec<Isa> {
+        let mut v = vec![Isa::Portable];
+        #[cfg(target_arch = "x86_64")]
+        if let Some(a) = avx2::Avx2::detect() {
+            v.push(Isa::Avx2(a));
+        }
+        v
+    }
+}
+
+/// The generic row compiled with AVX2 enabled, so the intrinsics inline.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn update_row_avx2(
+    s: avx2::Avx2,
+    channels: usize,
+    state: &mut [Lanes],
+    modes: &mut [[u8; LANES]],
+    frame: &[u8],
+    mask: &mut [u8],
+    co: &Coeffs,
+) {
+    if channels == 1 {
+        update_row_generic::<_, 1>(s, state, modes, frame, mask, co)
+    } else {
+        update_row_generic::<_, 3>(s, state, modes, frame, mask, co)
     }
 }
 
@@ -508,16 +713,19 @@ impl Isa {
 pub(super) fn update_row(
     isa: Isa,
     channels: usize,
-    state: &mut [[f32; LANES]],
+    state: &mut [Lanes],
     modes: &mut [[u8; LANES]],
     frame: &[u8],
     mask: &mut [u8],
     co: &Coeffs,
 ) {
     match isa {
-        Isa::Portable => update_row_portable(channels, state, modes, frame, mask, co),
+        Isa::Portable if channels == 1 => {
+            update_row_generic::<_, 1>(Portable, state, modes, frame, mask, co)
+        }
+        Isa::Portable => update_row_generic::<_, 3>(Portable, state, modes, frame, mask, co),
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: `Isa::Avx2` is only constructed after `is_x86_feature_detected!("avx2")`.
-        Isa::Avx2 => unsafe { update_row_avx2(channels, state, modes, frame, mask, co) },
+        // SAFETY: an `Avx2` token exists only after AVX2 was detected on this CPU.
+        Isa::Avx2(a) => unsafe { update_row_avx2(a, channels, state, modes, frame, mask, co) },
     }
 }

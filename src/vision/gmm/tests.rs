@@ -405,10 +405,7 @@ fn kernel_matches_scalar_reference_bit_for_bit() {
         ),
     ];
     let (w, h, n) = (13, 5, 120);
-    let mut isas = vec![Isa::Portable];
-    if Isa::detect() != Isa::Portable {
-        isas.push(Isa::detect());
-    }
+    let isas = Isa::available();
     for (i, (params, c, lr)) in cases.into_iter().enumerate() {
         for &isa in &isas {
             let frames = stress_frames(w, h, c, n, 7 + i as u64);
