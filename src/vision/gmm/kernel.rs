@@ -106,6 +106,8 @@ pub(super) trait Simd: Copy {
     fn and_not(self, a: Self::M, b: Self::M) -> Self::M;
     fn none(self) -> Self::M;
     fn all(self) -> Self::M;
+    /// `if m { a } else { +0.0 }` per lane.
+    fn keep(self, m: Self::M, a: Self::F) -> Self::F;
     /// One bit per lane (lane 0 in bit 0).
     fn bits(self, m: Self::M) -> u32;
     /// `if m { t } else { f }` per lane.
@@ -115,6 +117,9 @@ pub(super) trait Simd: Copy {
     fn load_pixels<const C: usize>(self, src: &[u8]) -> [Self::F; C];
     /// Component counts (small integers, exact in `f32`).
     fn load_counts(self, c: &[u8; LANES]) -> Self::F;
+    fn store_counts(self, c: &mut [u8; LANES], v: Self::F);
+    /// Mask bytes: 0 where `background`, else `shadow_value` where `shadow`, else 255.
+    fn mask_bytes(self, background: Self::M, shadow: Self::M, shadow_value: u8) -> [u8; LANES];
 }
 
 /// Plain arrays; LLVM vectorises what it can. Runs everywhere.
@@ -203,6 +208,10 @@ impl Simd for Portable {
         [u32::MAX; LANES]
     }
     #[inline(always)]
+    fn keep(self, m: Self::M, a: Lanes) -> Lanes {
+        lanes(|l| f32::from_bits(a[l].to_bits() & m[l]))
+    }
+    #[inline(always)]
     fn bits(self, m: Self::M) -> u32 {
         m.iter()
             .enumerate()
@@ -220,6 +229,22 @@ impl Simd for Portable {
     #[inline(always)]
     fn load_counts(self, c: &[u8; LANES]) -> Lanes {
         lanes(|l| f32::from(c[l]))
+    }
+    #[inline(always)]
+    fn store_counts(self, c: &mut [u8; LANES], v: Lanes) {
+        *c = lanes(|l| v[l] as u8);
+    }
+    #[inline(always)]
+    fn mask_bytes(self, background: Self::M, shadow: Self::M, shadow_value: u8) -> [u8; LANES] {
+        lanes(|l| {
+            if background[l] != 0 {
+                0
+            } else if shadow[l] != 0 {
+                shadow_value
+            } else {
+                255
+            }
+        })
     }
 }
 
@@ -311,6 +336,10 @@ mod avx2 {
             unsafe { _mm256_castsi256_ps(_mm256_set1_epi32(-1)) }
         }
         #[inline(always)]
+        fn keep(self, m: __m256, a: __m256) -> __m256 {
+            unsafe { _mm256_and_ps(m, a) }
+        }
+        #[inline(always)]
         fn bits(self, m: __m256) -> u32 {
             unsafe { _mm256_movemask_ps(m) as u32 }
         }
@@ -367,6 +396,34 @@ mod avx2 {
                 _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(v))
             }
         }
+        #[inline(always)]
+        fn store_counts(self, c: &mut [u8; LANES], v: __m256) {
+            // Counts are 0..=16: i32 -> i16 -> u8 packing cannot saturate.
+            unsafe {
+                let i = _mm256_cvttps_epi32(v);
+                let w =
+                    _mm_packs_epi32(_mm256_castsi256_si128(i), _mm256_extracti128_si256::<1>(i));
+                let b = _mm_packus_epi16(w, w);
+                _mm_storel_epi64(c.as_mut_ptr().cast(), b);
+            }
+        }
+        #[inline(always)]
+        fn mask_bytes(self, background: __m256, shadow: __m256, shadow_value: u8) -> [u8; LANES] {
+            let mut out = [0u8; LANES];
+            unsafe {
+                let fg = _mm256_blendv_ps(
+                    _mm256_set1_ps(255.0),
+                    _mm256_set1_ps(f32::from(shadow_value)),
+                    shadow,
+                );
+                let v = _mm256_andnot_ps(background, fg);
+                let i = _mm256_cvttps_epi32(v);
+                let w =
+                    _mm_packs_epi32(_mm256_castsi256_si128(i), _mm256_extracti128_si256::<1>(i));
+                _mm_storel_epi64(out.as_mut_ptr().cast(), _mm_packus_epi16(w, w));
+            }
+            out
+        }
     }
 }
 
@@ -394,14 +451,26 @@ impl Group<'_> {
         let i = self.at(k, f);
         s.store(&mut self.row[i], v)
     }
-    /// Swap slots `i` and `i - 1` in the lanes of `m`.
+    /// Field `f` of slot `k` in lane `l`.
     #[inline(always)]
-    fn swap_down<S: Simd>(&mut self, s: S, i: usize, m: S::M) {
-        for f in 0..self.layout.stride {
-            let hi = self.get(s, i, f);
-            let lo = self.get(s, i - 1, f);
-            self.set(s, i, f, s.select(m, lo, hi));
-            self.set(s, i - 1, f, s.select(m, hi, lo));
+    fn lane(&mut self, k: usize, f: usize, l: usize) -> &mut f32 {
+        let i = self.at(k, f);
+        &mut self.row[i][l]
+    }
+    /// Swap slots `i` and `i - 1` in the lanes whose bits are set. Reordering is rare, so
+    /// it is done lane by lane: a blended vector store of a value loaded from the same place
+    /// becomes a masked store, which is slow on some CPUs.
+    #[inline(always)]
+    fn swap_down(&mut self, i: usize, mut bits: u32) {
+        while bits != 0 {
+            let l = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            for f in 0..self.layout.stride {
+                let (hi, lo) = (self.at(i, f), self.at(i - 1, f));
+                let t = self.row[hi][l];
+                self.row[hi][l] = self.row[lo][l];
+                self.row[lo][l] = t;
+            }
         }
     }
 }
@@ -432,7 +501,7 @@ fn update_group<S: Simd, const C: usize>(
     let zero = s.splat(0.0);
     let one = s.splat(1.0);
 
-    let mut most = usize::from(modes.iter().copied().max().unwrap_or(0));
+    let mut most = usize::from(modes.iter().fold(0, |a, &m| a.max(m)));
     let mut nm = s.load_counts(modes);
     let mut fits = s.none();
     let mut background = s.none();
@@ -460,18 +529,25 @@ fn update_group<S: Simd, const C: usize>(
             background = s.or(background, s.and(open, in_background));
             owner = s.and(open, s.lt(dist2, s.mul(tg, var)));
             if s.bits(owner) != 0 {
+                // Non-owner lanes must keep their mean and variance. Instead of blending the
+                // results (which the compiler turns into masked stores, slow on some CPUs),
+                // their step `r` is zeroed: `m - 0` and `v + 0 * (..)` are exactly `m` and `v`.
                 let w_own = s.add(w, alpha);
-                let r = s.div(alpha, w_own);
+                let r = s.keep(owner, s.div(alpha, w_own));
                 for (c, dc) in d.iter().enumerate() {
                     let m = grp.get(s, k, 2 + c);
-                    grp.set(s, k, 2 + c, s.select(owner, s.sub(m, s.mul(r, *dc)), m));
+                    grp.set(s, k, 2 + c, s.sub(m, s.mul(r, *dc)));
                 }
                 let mut var_new = s.add(var, s.mul(r, s.sub(dist2, var)));
+                // Clamp only the owners' (a variance never updated may lie outside the range
+                // when fVarInit does).
                 let var_min = s.splat(co.var_min);
                 let var_max = s.splat(co.var_max);
-                var_new = s.select(s.lt(var_new, var_min), var_min, var_new);
-                var_new = s.select(s.lt(var_max, var_new), var_max, var_new);
-                grp.set(s, k, 1, s.select(owner, var_new, var));
+                let low = s.and(owner, s.lt(var_new, var_min));
+                var_new = s.select(low, var_min, var_new);
+                let high = s.and(owner, s.lt(var_max, var_new));
+                var_new = s.select(high, var_max, var_new);
+                grp.set(s, k, 1, var_new);
                 w = s.select(owner, w_own, w);
                 fits = s.or(fits, owner);
             }
@@ -480,14 +556,16 @@ fn update_group<S: Simd, const C: usize>(
         let dropped = s.and(active, s.lt(w, neg_prune));
         let w_kept = s.select(dropped, zero, w);
         nm = s.sub(nm, s.select(dropped, one, zero));
-        grp.set(s, k, 0, s.select(active, w_kept, w_old));
+        // Lanes where slot k is not in use get a meaningless value: a slot at or past a
+        // pixel's count is never read before a new component overwrites it whole.
+        grp.set(s, k, 0, w_kept);
         // The owner moves up past every component whose weight is not larger.
         let mut moving = owner;
         let mut i = k;
         while i > 0 && s.bits(moving) != 0 {
             let up = grp.get(s, i - 1, 0);
             let swap = s.and_not(moving, s.lt(w, up));
-            grp.swap_down(s, i, swap);
+            grp.swap_down(i, s.bits(swap));
             moving = swap;
             i -= 1;
         }
@@ -498,9 +576,9 @@ fn update_group<S: Simd, const C: usize>(
     let nonzero = s.lt(s.splat(f32::EPSILON), s.abs(total));
     let inv = s.select(nonzero, s.div(one, total), zero);
     for k in 0..most {
-        let live = above(s, nm, k);
+        // Slots past a lane's count are dead (see above), so no lane mask is needed.
         let w = grp.get(s, k, 0);
-        grp.set(s, k, 0, s.select(live, s.mul(w, inv), w));
+        grp.set(s, k, 0, s.mul(w, inv));
     }
 
     // A sample no component owns starts a new one (replacing the weakest when full).
@@ -509,60 +587,53 @@ fn update_group<S: Simd, const C: usize>(
     } else {
         s.none()
     };
-    if s.bits(new) != 0 {
+    let new_bits = s.bits(new);
+    if new_bits != 0 {
         let full = s.eq(nm, s.splat(co.n_mix as f32));
         nm = s.add(nm, s.select(s.and_not(new, full), one, zero));
         most = (most + 1).min(co.n_mix);
-        let only = s.and(new, s.eq(nm, one));
-        let w_new = s.select(only, one, alpha);
-        for k in 0..most {
-            let is_slot = s.and(new, s.eq(nm, s.splat(k as f32 + 1.0)));
-            let older = s.and(s.and_not(new, only), above(s, nm, k + 1));
+        // The new component's lanes scale their older components by 1 - α (the others by
+        // 1, which is exact), vector-wide.
+        for k in 0..most - 1 {
+            let older = s.and(new, above(s, nm, k + 1));
             let w = grp.get(s, k, 0);
-            let w = s.select(older, s.mul(w, alpha1), w);
-            grp.set(s, k, 0, s.select(is_slot, w_new, w));
-            let v = grp.get(s, k, 1);
-            grp.set(s, k, 1, s.select(is_slot, s.splat(co.var_init), v));
-            for (c, xc) in x.iter().enumerate() {
-                let m = grp.get(s, k, 2 + c);
-                grp.set(s, k, 2 + c, s.select(is_slot, *xc, m));
-            }
+            grp.set(s, k, 0, s.mul(w, s.select(older, alpha1, one)));
         }
-        let mut moving = new;
-        for i in (1..most).rev() {
-            if s.bits(moving) == 0 {
-                break;
+        // Then, lane by lane, the component itself goes into slot count - 1 and moves up
+        // past every weight not larger than α.
+        s.store_counts(modes, nm);
+        let mut xs = [[0.0f32; LANES]; C];
+        for (xc, v) in xs.iter_mut().zip(x) {
+            s.store(xc, *v);
+        }
+        let mut bits = new_bits;
+        while bits != 0 {
+            let l = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let n = usize::from(modes[l]);
+            let k = n - 1;
+            *grp.lane(k, 0, l) = if n == 1 { 1.0 } else { co.alpha };
+            *grp.lane(k, 1, l) = co.var_init;
+            for (c, xc) in xs.iter().enumerate() {
+                *grp.lane(k, 2 + c, l) = xc[l];
             }
-            let in_play = s.and(moving, above(s, nm, i));
-            let up = grp.get(s, i - 1, 0);
-            let swap = s.and_not(in_play, s.lt(alpha, up));
-            grp.swap_down(s, i, swap);
-            moving = s.and_not(moving, s.and_not(in_play, swap));
+            let mut i = k;
+            while i > 0 && !(co.alpha < *grp.lane(i - 1, 0, l)) {
+                grp.swap_down(i, 1 << l);
+                i -= 1;
+            }
         }
     }
 
-    let mut counts = [0.0f32; LANES];
-    s.store(&mut counts, nm);
-    for (m, c) in modes.iter_mut().zip(counts) {
-        *m = c as u8;
-    }
+    s.store_counts(modes, nm);
 
-    let bg_bits = s.bits(background);
-    let shadow_bits = if co.detect_shadows && bg_bits != (1 << LANES) - 1 {
+    let shadow = if co.detect_shadows && s.bits(background) != (1 << LANES) - 1 {
         let foreground = s.and_not(s.all(), background);
-        s.bits(detect_shadow::<S, C>(s, grp, nm, most, x, foreground, co))
+        detect_shadow::<S, C>(s, grp, nm, most, x, foreground, co)
     } else {
-        0
+        s.none()
     };
-    std::array::from_fn(|l| {
-        if bg_bits >> l & 1 != 0 {
-            0
-        } else if shadow_bits >> l & 1 != 0 {
-            co.shadow_value
-        } else {
-            255
-        }
-    })
+    s.mask_bytes(background, shadow, co.shadow_value)
 }
 
 /// The shadow test of Prati et al. as OpenCV's `detectShadowGMM` applies it: the sample is
