@@ -47,6 +47,10 @@ WAVING_TREES := ../shared/real/wallflower_waving_trees/WavingTrees
 opencv-agreement: $(VENV)/opencv-ok
 	$(CARGO) run --quiet --release --example gmm_masks -- synthetic $(GMM_OUT)/synthetic
 	$(VENV)/bin/python tools/opencv_mog2_agreement.py $(GMM_OUT)/synthetic
+	$(CARGO) run --quiet --release --example gmm_masks -- synthetic-grey $(GMM_OUT)/synthetic_grey
+	$(VENV)/bin/python tools/opencv_mog2_agreement.py $(GMM_OUT)/synthetic_grey
+	$(CARGO) run --quiet --release --example gmm_masks -- synthetic $(GMM_OUT)/synthetic_sg --stauffer-grimson
+	$(VENV)/bin/python tools/opencv_mog2_agreement.py $(GMM_OUT)/synthetic_sg
 	@if [ -d $(WAVING_TREES) ]; then \
 		$(CARGO) run --quiet --release --example gmm_masks -- wallflower $(WAVING_TREES) $(GMM_OUT)/waving_trees && \
 		$(VENV)/bin/python tools/opencv_mog2_agreement.py $(GMM_OUT)/waving_trees; \

@@ -3,11 +3,15 @@
 //! OpenCV on the same bytes and compare pixel by pixel.
 //!
 //! Usage:
-//!   gmm_masks synthetic OUT_DIR [WIDTH HEIGHT FRAMES]   (default 320 240 300)
+//!   gmm_masks synthetic OUT_DIR [WIDTH HEIGHT FRAMES]        (default 320 240 300)
+//!   gmm_masks synthetic-grey OUT_DIR [WIDTH HEIGHT FRAMES]   (the same scene in grey)
 //!   gmm_masks wallflower WAVING_TREES_DIR OUT_DIR
 //!
-//! OUT_DIR gets `frames.bin` (FRAMES x HEIGHT x WIDTH x 3 bytes, the channel order the model
-//! saw), `masks.bin` (FRAMES x HEIGHT x WIDTH), `meta.json` (shape and parameters) and, for
+//! With `--stauffer-grimson` anywhere, the model is the fixed-M baseline
+//! (`GmmParams::stauffer_grimson`) instead of OpenCV's defaults.
+//!
+//! OUT_DIR gets `frames.bin` (FRAMES x HEIGHT x WIDTH x CHANNELS bytes, the channel order the
+//! model saw), `masks.bin` (FRAMES x HEIGHT x WIDTH), `meta.json` (shape and parameters) and, for
 //! Wallflower, `truth.bin` (the hand-segmented mask of the evaluated frame, 0/255), plus
 //! PNGs of the last mask, the background image and the components per pixel (fig. 2).
 
@@ -27,10 +31,17 @@ type Res<T> = Result<T, Box<dyn std::error::Error>>;
 const WALLFLOWER_EVAL_FRAME: usize = 247;
 
 fn main() -> Res<()> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let baseline = args.iter().any(|a| a == "--stauffer-grimson");
+    args.retain(|a| a != "--stauffer-grimson");
+    let params = if baseline {
+        GmmParams::stauffer_grimson()
+    } else {
+        GmmParams::default()
+    };
     let strs: Vec<&str> = args.iter().map(String::as_str).collect();
     match strs.as_slice() {
-        ["synthetic", out, rest @ ..] => {
+        [kind @ ("synthetic" | "synthetic-grey"), out, rest @ ..] => {
             let num = |i: usize, d: usize| -> Res<usize> {
                 Ok(rest.get(i).map(|s| s.parse()).transpose()?.unwrap_or(d))
             };
@@ -39,12 +50,30 @@ fn main() -> Res<()> {
                 height: num(1, 240)?,
                 seed: 2004,
             };
-            let frames: Vec<Vec<u8>> = (0..num(2, 300)?).map(|t| scene.frame(t)).collect();
+            let mut frames: Vec<Vec<u8>> = (0..num(2, 300)?).map(|t| scene.frame(t)).collect();
+            let channels = if *kind == "synthetic" { 3 } else { 1 };
+            if channels == 1 {
+                // Integer BT.601 luma; any fixed conversion will do, both sides see the bytes.
+                for f in &mut frames {
+                    *f = f
+                        .chunks_exact(3)
+                        .map(|p| {
+                            let (r, g, b) = (u32::from(p[0]), u32::from(p[1]), u32::from(p[2]));
+                            ((77 * r + 150 * g + 29 * b + 128) >> 8) as u8
+                        })
+                        .collect();
+                }
+            }
+            let name = if baseline {
+                format!("{kind} (Stauffer-Grimson)")
+            } else {
+                kind.to_string()
+            };
             run(
-                "synthetic",
+                &name,
+                params,
                 &frames,
-                scene.width,
-                scene.height,
+                (scene.width, scene.height, channels),
                 None,
                 Path::new(out),
             )
@@ -76,15 +105,15 @@ fn main() -> Res<()> {
                 .collect();
             run(
                 "wallflower_waving_trees",
+                params,
                 &frames,
-                w,
-                h,
+                (w, h, 3),
                 Some((WALLFLOWER_EVAL_FRAME, truth)),
                 Path::new(out),
             )
         }
         _ => Err(
-            "usage: gmm_masks synthetic OUT_DIR [W H FRAMES] | gmm_masks wallflower DIR OUT_DIR"
+            "usage: gmm_masks synthetic|synthetic-grey OUT_DIR [W H FRAMES] | gmm_masks wallflower DIR OUT_DIR"
                 .into(),
         ),
     }
@@ -92,17 +121,16 @@ fn main() -> Res<()> {
 
 fn run(
     name: &str,
+    params: GmmParams,
     frames: &[Vec<u8>],
-    width: usize,
-    height: usize,
+    (width, height, channels): (usize, usize, usize),
     eval: Option<(usize, Vec<u8>)>,
     out: &Path,
 ) -> Res<()> {
-    let params = GmmParams::default();
     let mut gmm = AdaptiveGmm::new(params)?;
     let mut masks = vec![0u8; frames.len() * width * height];
     for (f, m) in frames.iter().zip(masks.chunks_exact_mut(width * height)) {
-        gmm.apply(ImageView::new(f, width, height, 3)?, None, m)?;
+        gmm.apply(ImageView::new(f, width, height, channels)?, None, m)?;
     }
     fs::create_dir_all(out)?;
     fs::write(out.join("frames.bin"), frames.concat())?;
@@ -111,7 +139,7 @@ fn run(
         "name": name,
         "width": width,
         "height": height,
-        "channels": 3,
+        "channels": channels,
         "frames": frames.len(),
         "params": params,
     });
@@ -142,9 +170,16 @@ fn run(
     GrayImage::from_raw(w, h, last.to_vec())
         .ok_or("mask size")?
         .save(out.join("last_mask.png"))?;
-    RgbImage::from_raw(w, h, gmm.background_image()?)
-        .ok_or("background size")?
-        .save(out.join("background.png"))?;
+    let background = gmm.background_image()?;
+    if channels == 3 {
+        RgbImage::from_raw(w, h, background)
+            .ok_or("background size")?
+            .save(out.join("background.png"))?;
+    } else {
+        GrayImage::from_raw(w, h, background)
+            .ok_or("background size")?
+            .save(out.join("background.png"))?;
+    }
     // Black: one component; white: all M in use.
     let top = (params.n_mixtures - 1).max(1);
     let comps: Vec<u8> = gmm
