@@ -41,7 +41,7 @@ impl Scene {
         let (xf, yf) = (x as f64, y as f64);
         let r = 120.0 + 70.0 * (xf / 11.0).sin() * (yf / 17.0).cos();
         let g = 110.0 + 60.0 * ((xf + yf) / 23.0).sin();
-        let checker = ((x / 16) + (y / 16)) % 2 == 0;
+        let checker = ((x / 16) + (y / 16)).is_multiple_of(2);
         let b = if checker { 170.0 } else { 60.0 } + 20.0 * (yf / 7.0).sin();
         [r as i32, g as i32, b as i32]
     }
@@ -68,7 +68,7 @@ impl Scene {
         let (ox, oy, ow, oh) = self.object(t);
         // The shadow is the object's footprint shifted down and to the right.
         let (sx, sy) = (ox + ow / 3, oy + oh / 2);
-        let flicker_on = mix(self.seed ^ (t as u64).wrapping_mul(0x51)) % 3 != 0;
+        let flicker_on = !mix(self.seed ^ (t as u64).wrapping_mul(0x51)).is_multiple_of(3);
         let (fx0, fy0, fx1, fy1) = (w * 3 / 4, h * 2 / 3, w * 3 / 4 + w / 6, h * 2 / 3 + h / 5);
         for y in 0..h {
             for x in 0..w {

@@ -475,6 +475,12 @@ impl Group<'_> {
     }
 }
 
+/// `!(a < b)`, true for NaN too (OpenCV's loop test `if (alpha < w) break;`).
+#[inline(always)]
+fn not_less(a: f32, b: f32) -> bool {
+    a.partial_cmp(&b) != Some(std::cmp::Ordering::Less)
+}
+
 /// `count > k` per lane, for counts held as exact small floats.
 #[inline(always)]
 fn above<S: Simd>(s: S, count: S::F, k: usize) -> S::M {
@@ -618,7 +624,7 @@ fn update_group<S: Simd, const C: usize>(
                 *grp.lane(k, 2 + c, l) = xc[l];
             }
             let mut i = k;
-            while i > 0 && !(co.alpha < *grp.lane(i - 1, 0, l)) {
+            while i > 0 && not_less(co.alpha, *grp.lane(i - 1, 0, l)) {
                 grp.swap_down(i, 1 << l);
                 i -= 1;
             }

@@ -1,5 +1,7 @@
 //! A plain scalar, one-pixel-at-a-time statement of the update (test only). The vectorised
 //! kernel must reproduce it bit for bit; it is written for reading, not for speed.
+// Channel loops index several arrays at once, as the C++ they mirror does.
+#![allow(clippy::needless_range_loop)]
 
 use super::GmmParams;
 

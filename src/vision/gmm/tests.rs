@@ -65,8 +65,10 @@ fn expected_two_colours(alpha: f64, ct: f64, n: usize) -> (f64, Option<f64>) {
         let a = a.filter(|&w| w >= -prune);
         match wb {
             None => {
-                // B is new: normalise A, then B takes α and A is scaled by 1 - α.
-                wa = a.map(|w| w / w * (1.0 - alpha));
+                // B is new: normalise A (the only weight, so the total is A itself), then B
+                // takes α and A is scaled by 1 - α.
+                let total = a.unwrap_or(1.0);
+                wa = a.map(|w| w / total * (1.0 - alpha));
                 wb = Some(alpha);
             }
             Some(b) => {
