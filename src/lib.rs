@@ -14,5 +14,6 @@ pub mod report;
 pub mod run;
 pub mod synth;
 pub mod time;
+pub mod vision;
 
 pub use time::Nanos;
