@@ -4,16 +4,19 @@
 //! detections and tracks, and evaluation turns tracks into tables and figures. See
 //! `ARCHITECTURE.md` for the map.
 
+pub mod calib;
 pub mod cli;
 pub mod eval;
 pub mod geometry;
 pub mod groundtruth;
+pub mod learn;
 pub mod log;
 pub mod pipelines;
 pub mod report;
 pub mod run;
 pub mod synth;
 pub mod time;
+pub mod track;
 pub mod vision;
 
 pub use time::Nanos;

@@ -15,6 +15,8 @@ use crate::log::TfBuffer;
 use crate::log::stats::{StatsOptions, topic_stats};
 use crate::report::figure::{FigureKind, LinePlot, Series};
 use crate::report::{Figure, Table};
+
+use super::columns::{concat as stack, f64s as col_f64, strs as col_str};
 use crate::run::config::Invalid;
 use crate::run::{Aggregate, Experiment, Frames, Products, Session, Stage};
 
@@ -44,24 +46,6 @@ fn topic(topics: &BTreeMap<String, String>, logical: &str, default: &str) -> Str
         .get(logical)
         .cloned()
         .unwrap_or_else(|| default.to_string())
-}
-
-fn col_f64(df: &DataFrame, name: &str) -> PolarsResult<Vec<f64>> {
-    Ok(df
-        .column(name)?
-        .f64()?
-        .iter()
-        .map(|v| v.unwrap_or(f64::NAN))
-        .collect())
-}
-
-fn col_str(df: &DataFrame, name: &str) -> PolarsResult<Vec<String>> {
-    Ok(df
-        .column(name)?
-        .str()?
-        .iter()
-        .map(|v| v.unwrap_or_default().to_string())
-        .collect())
 }
 
 impl Experiment for DatasetQuality {
@@ -242,16 +226,8 @@ impl Experiment for DatasetQuality {
             )?;
             topics.push(t);
         }
-        let concat = |v: Vec<DataFrame>| -> PolarsResult<DataFrame> {
-            let mut it = v.into_iter();
-            let mut acc = it.next().unwrap_or_default();
-            for df in it {
-                acc.vstack_mut(&df)?;
-            }
-            Ok(acc)
-        };
-        let sessions_df = concat(sessions)?;
-        let topics_df = concat(topics)?;
+        let sessions_df = stack(sessions)?;
+        let topics_df = stack(topics)?;
         let mut products = Products::default();
         let n_sessions = sessions_df.height();
         let total_s: f64 = col_f64(&sessions_df, "duration_s")?.iter().sum();

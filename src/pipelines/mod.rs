@@ -1,14 +1,16 @@
 //! The experiments, one module each, and the registry that maps a pipeline file's `kind` to
 //! its implementation.
 
+pub mod columns;
 pub mod dataset_quality;
+pub mod omni_appearance;
 
 use std::path::Path;
 
 use crate::run::{Experiment, RunOptions, RunSummary, config, run_experiment, unknown_kind};
 
 /// Every `pipeline.kind` this build knows.
-pub const KINDS: &[&str] = &[dataset_quality::DatasetQuality::KIND];
+pub const KINDS: &[&str] = &[dataset_quality::DatasetQuality::KIND, omni_appearance::OmniAppearance::KIND];
 
 /// Run one pipeline file, dispatching on its `kind`.
 pub fn run_file(path: &Path, opts: &RunOptions) -> anyhow::Result<RunSummary> {

@@ -60,6 +60,9 @@ pub struct Products {
     pub figures: Vec<Figure>,
     /// Lines for the report (key findings, caveats).
     pub summary: Vec<String>,
+    /// Other files (e.g. a trained model): `(path, bytes)`, written atomically; relative paths
+    /// are below `out/<pipeline>/`.
+    pub artifacts: Vec<(PathBuf, Vec<u8>)>,
 }
 
 /// Context handed to `aggregate`.
@@ -130,6 +133,8 @@ pub struct RunSummary {
     pub tables: Vec<(String, String)>,
     pub figures: Vec<(String, String)>,
     pub summary: Vec<String>,
+    /// Paths of other files written (models).
+    pub artifacts: Vec<String>,
     pub seconds: f64,
     /// Dry-run plan text (empty for real runs).
     pub plan: String,
@@ -314,6 +319,7 @@ pub fn run_experiment<E: Experiment>(
         tables: Vec::new(),
         figures: Vec::new(),
         summary: Vec::new(),
+        artifacts: Vec::new(),
         seconds: 0.0,
         plan: String::new(),
     };
@@ -460,6 +466,11 @@ pub fn run_experiment<E: Experiment>(
         summary
             .figures
             .push((f.title.clone(), format!("{name}/figures/{}.png", f.name)));
+    }
+    for (path, bytes) in &products.artifacts {
+        let path = if path.is_absolute() { path.clone() } else { pipeline_dir.join(path) };
+        atomic::write_atomic(&path, bytes, Some(&opts.out)).with_context(|| format!("writing {}", path.display()))?;
+        summary.artifacts.push(path.display().to_string());
     }
     summary.summary = products.summary;
     summary.seconds = started.elapsed().as_secs_f64();

@@ -125,6 +125,7 @@ mod tests {
                 "dataset_quality/figures/rates_lab.png".into(),
             )],
             summary: vec!["3 sessions.".into()],
+            artifacts: Vec::new(),
             seconds: 1.25,
             plan: String::new(),
         };

@@ -628,11 +628,13 @@ pub fn write_session(
                     (world_pose, &world)
                 });
                 let cam = Camera::new(&camera.name, model.clone(), camera.noise, fixed, k as u64);
+                // TF carries what the installer believes (the nominal pose); a perturbed camera
+                // renders from its true pose, recorded only in the `peopletrack.truth` metadata
                 statics.push(tf(
                     if on_robot { "base_link" } else { "map" },
                     &camera.name,
                     at(0.0),
-                    &pose,
+                    &nominal,
                 ));
                 truth_cams.push(CameraTruth {
                     name: camera.name.clone(),

@@ -14,6 +14,7 @@
 //! writes files.
 
 pub mod gmm;
+pub mod omni;
 pub mod score;
 pub mod synthetic;
 pub mod view;

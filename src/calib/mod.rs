@@ -1,0 +1,3 @@
+//! Calibration: the webcam measurement system of seed 000 ([`external`]).
+
+pub mod external;

@@ -1,0 +1,3 @@
+//! Learned models: the appearance-model network of seed 000 ([`mlp`]).
+
+pub mod mlp;
