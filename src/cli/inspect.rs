@@ -48,6 +48,10 @@ pub struct Report {
     pub tf_tree: Vec<TfEdge>,
     pub tf_tree_text: String,
     pub tf_skipped_invalid: u64,
+    /// Frames published on both /tf and /tf_static (the moving samples win).
+    pub tf_static_and_dynamic: u64,
+    /// Times a frame changed parent.
+    pub tf_reparented: u64,
     pub metadata: BTreeMap<String, BTreeMap<String, String>>,
 }
 
@@ -99,6 +103,8 @@ pub fn analyze(log: &SessionLog) -> Result<Report, LogError> {
             .collect(),
         tf_tree_text: tf.render_tree(),
         tf_skipped_invalid: tf.stats().skipped_invalid,
+        tf_static_and_dynamic: tf.stats().static_and_dynamic,
+        tf_reparented: tf.stats().reparented,
         metadata: s
             .metadata
             .iter()
@@ -182,6 +188,12 @@ pub fn render_text(r: &Report) -> String {
     }
     if r.tf_skipped_invalid > 0 {
         let _ = writeln!(o, "  ({} invalid transforms skipped)", r.tf_skipped_invalid);
+    }
+    if r.tf_static_and_dynamic > 0 {
+        let _ = writeln!(o, "  (warning: {} transforms for frames on both /tf and /tf_static; the moving samples win)", r.tf_static_and_dynamic);
+    }
+    if r.tf_reparented > 0 {
+        let _ = writeln!(o, "  (warning: frames changed parent {} times; the newest parent wins)", r.tf_reparented);
     }
     for (name, entries) in &r.metadata {
         let _ = writeln!(o, "metadata {name}:");

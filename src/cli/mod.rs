@@ -7,6 +7,7 @@ pub mod inspect;
 pub mod run;
 pub mod score;
 pub mod synth;
+pub mod train;
 
 use std::io::{self, Write};
 use std::process::ExitCode;
@@ -52,6 +53,9 @@ pub enum Command {
     /// Score tracks against ground truth (MOTChallenge CSV): HOTA, CLEAR MOT (MOTA, MOTP,
     /// switches, MT/PT/ML) and IDF1.
     Score(score::Args),
+    /// Train a model on your own logs and save it for `run` to load, e.g.
+    /// `peopletrack train omni-appearance --sessions 'logs/*.mcap'`.
+    Train(train::Args),
 }
 
 /// Parse arguments, run the command, and map the outcome to an exit code:
@@ -78,6 +82,7 @@ pub fn main() -> ExitCode {
         Command::Eval(a) => eval::run(a, &mut out),
         Command::Synth(a) => synth::run(a, &mut out),
         Command::Score(a) => score::run(a, &mut out),
+        Command::Train(a) => train::run(a, &mut out),
     }
     .and_then(|()| out.flush().map_err(anyhow::Error::from));
     match result {

@@ -79,6 +79,9 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     for (t, p) in s.tables.iter().chain(&s.figures) {
         writeln!(out, "  {}  {t}", a.out.join(p).display())?;
     }
+    for p in &s.artifacts {
+        writeln!(out, "  {p}")?;
+    }
     for (session, why) in &s.skipped {
         eprintln!("warning: skipped {session}: {why}");
     }

@@ -60,6 +60,9 @@ pub struct TfStats {
     pub skipped_invalid: u64,
     /// Times a child frame was re-parented (the newest parent wins, as in tf2).
     pub reparented: u64,
+    /// Transforms for a child that is published both on `/tf` and on `/tf_static` with the
+    /// same parent; the time-varying samples win, the static one is dropped.
+    pub static_and_dynamic: u64,
 }
 
 /// One edge of the frame tree, for `inspect`.
@@ -139,9 +142,18 @@ impl TfBuffer {
             };
         }
         if is_static {
+            if !edge.is_static && !edge.samples.is_empty() {
+                self.stats.static_and_dynamic += 1;
+                return;
+            }
             edge.is_static = true;
             edge.samples = vec![(stamp, iso)];
             return;
+        }
+        if edge.is_static {
+            self.stats.static_and_dynamic += 1;
+            edge.is_static = false;
+            edge.samples.clear();
         }
         match edge.samples.binary_search_by_key(&stamp, |(s, _)| *s) {
             Ok(i) => edge.samples[i] = (stamp, iso),
@@ -389,5 +401,26 @@ mod tests {
         b.insert(&t, false);
         assert_eq!(b.stats().skipped_invalid, 1);
         assert!(b.lookup("a", "b", Nanos(0)).is_err());
+    }
+
+    #[test]
+    fn a_frame_on_both_tf_and_tf_static_keeps_its_moving_samples_either_order() {
+        for static_first in [true, false] {
+            let mut b = TfBuffer::new(0.0);
+            let stat = tf("map", "odom", 0, [0.0; 3], 0.0);
+            let moving = [tf("map", "odom", 0, [5.0, 0.0, 0.0], 0.0), tf("map", "odom", 10, [7.0, 0.0, 0.0], 0.0)];
+            if static_first {
+                b.insert(&stat, true);
+            }
+            for m in &moving {
+                b.insert(m, false);
+            }
+            if !static_first {
+                b.insert(&stat, true);
+            }
+            let m = b.lookup("map", "odom", Nanos(5)).expect("moving edge");
+            assert!((m.translation.vector.x - 6.0).abs() < 1e-12, "static_first {static_first}: {m}");
+            assert_eq!(b.stats().static_and_dynamic, 1, "static_first {static_first}");
+        }
     }
 }

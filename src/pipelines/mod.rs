@@ -19,6 +19,39 @@ pub fn run_file(path: &Path, opts: &RunOptions) -> anyhow::Result<RunSummary> {
         dataset_quality::DatasetQuality::KIND => {
             run_experiment::<dataset_quality::DatasetQuality>(path, &text, opts)
         }
+        omni_appearance::OmniAppearance::KIND => {
+            run_experiment::<omni_appearance::OmniAppearance>(path, &text, opts)
+        }
         _ => Err(unknown_kind(path, &kind, KINDS).into()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every kind listed in `KINDS` has a dispatch arm: a file naming it fails (it has no
+    /// inputs) for any reason but an unknown kind.
+    #[test]
+    fn every_listed_kind_is_dispatched() {
+        let dir = tempfile::tempdir().unwrap();
+        for kind in KINDS {
+            let path = dir.path().join(format!("{kind}.toml"));
+            std::fs::write(&path, format!("[pipeline]\nname = \"x\"\nkind = \"{kind}\"\n")).unwrap();
+            let opts = RunOptions {
+                sessions: None,
+                dry_run: false,
+                shard: None,
+                aggregate_only: false,
+                force: false,
+                out: dir.path().join("out"),
+                git_commit: String::new(),
+                progress: false,
+            };
+            if let Err(e) = run_file(&path, &opts) {
+                let msg = format!("{e:#}");
+                assert!(!msg.contains("unknown pipeline kind"), "{kind}: {msg}");
+            }
+        }
     }
 }
