@@ -44,7 +44,13 @@ pub fn wrap(a: f64) -> f64 {
 
 /// Where the rays of two cameras cross, if they cross in front of both and not at a grazing
 /// angle (below `min_angle` rad the position is too ill-conditioned to use).
-pub fn intersect(a: &BearingCamera, pa: f64, b: &BearingCamera, pb: f64, min_angle: f64) -> Option<(f64, f64)> {
+pub fn intersect(
+    a: &BearingCamera,
+    pa: f64,
+    b: &BearingCamera,
+    pb: f64,
+    min_angle: f64,
+) -> Option<(f64, f64)> {
     let (da, db) = ((pa.cos(), pa.sin()), (pb.cos(), pb.sin()));
     let det = da.0 * (-db.1) - da.1 * (-db.0);
     if det.abs() < min_angle.sin() {
@@ -53,7 +59,7 @@ pub fn intersect(a: &BearingCamera, pa: f64, b: &BearingCamera, pb: f64, min_ang
     let (rx, ry) = (b.x - a.x, b.y - a.y);
     let s = (rx * (-db.1) - ry * (-db.0)) / det;
     let t = (da.0 * ry - da.1 * rx) / det;
-    (s > 0.0 && t > 0.0).then(|| (a.x + s * da.0, a.y + s * da.1))
+    (s > 0.0 && t > 0.0).then_some((a.x + s * da.0, a.y + s * da.1))
 }
 
 /// Position from the cameras that see the whole hat: `(camera index, column)` pairs. Every
@@ -65,7 +71,13 @@ pub fn locate(cams: &[BearingCamera], seen: &[(usize, f64)]) -> Option<(f64, f64
         for j in i + 1..seen.len() {
             let (ci, ui) = seen[i];
             let (cj, uj) = seen[j];
-            if let Some(p) = intersect(&cams[ci], cams[ci].bearing(ui), &cams[cj], cams[cj].bearing(uj), 10f64.to_radians()) {
+            if let Some(p) = intersect(
+                &cams[ci],
+                cams[ci].bearing(ui),
+                &cams[cj],
+                cams[cj].bearing(uj),
+                10f64.to_radians(),
+            ) {
                 sum = (sum.0 + p.0, sum.1 + p.1);
                 n += 1;
             }
@@ -127,8 +139,14 @@ impl CostFunction for Problem<'_> {
 
 /// Estimate every camera's parameters from `start` (e.g. the installer's nominal poses).
 /// Returns the cameras and `d̄` after calibration.
-pub fn calibrate(start: &[BearingCamera], samples: &[Sample]) -> Result<(Vec<BearingCamera>, f64), String> {
-    let mut best: Vec<f64> = start.iter().flat_map(|c| [c.alpha, c.x, c.y, c.range]).collect();
+pub fn calibrate(
+    start: &[BearingCamera],
+    samples: &[Sample],
+) -> Result<(Vec<BearingCamera>, f64), String> {
+    let mut best: Vec<f64> = start
+        .iter()
+        .flat_map(|c| [c.alpha, c.x, c.y, c.range])
+        .collect();
     let mut best_cost = mean_distance(start, samples);
     // simplex steps: 3° for angles, 0.15 m for positions
     let steps = [3f64.to_radians(), 0.15, 0.15, 3f64.to_radians()];
@@ -140,14 +158,18 @@ pub fn calibrate(start: &[BearingCamera], samples: &[Sample]) -> Result<(Vec<Bea
             v[k] += steps[k % 4];
             simplex.push(v);
         }
-        let solver = NelderMead::new(simplex).with_sd_tolerance(1e-13).map_err(|e| e.to_string())?;
+        let solver = NelderMead::new(simplex)
+            .with_sd_tolerance(1e-13)
+            .map_err(|e| e.to_string())?;
         let problem = Problem { start, samples };
         let res = Executor::new(problem, solver)
             .configure(|s| s.max_iters(4000))
             .run()
             .map_err(|e| e.to_string())?;
         let state = res.state();
-        let (Some(p), cost) = (state.best_param.clone(), state.best_cost) else { break };
+        let (Some(p), cost) = (state.best_param.clone(), state.best_cost) else {
+            break;
+        };
         if cost < best_cost - 1e-9 {
             best = p;
             best_cost = cost;
@@ -171,7 +193,13 @@ pub struct Blob {
 
 /// Find the pixels of a hue band (degrees, e.g. 90..150 for green) with at least `min_sat`
 /// saturation and `min_val` value, and return their centroid (one hat per image).
-pub fn find_hue_blob(img: &RgbImage, hue: (f64, f64), min_sat: f64, min_val: f64, min_area: u32) -> Option<Blob> {
+pub fn find_hue_blob(
+    img: &RgbImage,
+    hue: (f64, f64),
+    min_sat: f64,
+    min_val: f64,
+    min_area: u32,
+) -> Option<Blob> {
     let (w, h) = img.dimensions();
     let (mut su, mut sv, mut n) = (0.0f64, 0.0f64, 0u32);
     let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0, 0);
@@ -231,7 +259,11 @@ mod tests {
     fn two_bearings_on_noise_free_data_triangulate_exactly() {
         let c = cams();
         let p = (6.3, 1.7);
-        let seen: Vec<(usize, f64)> = c.iter().enumerate().map(|(i, k)| (i, k.column((p.1 - k.y).atan2(p.0 - k.x)))).collect();
+        let seen: Vec<(usize, f64)> = c
+            .iter()
+            .enumerate()
+            .map(|(i, k)| (i, k.column((p.1 - k.y).atan2(p.0 - k.x))))
+            .collect();
         let (x, y) = locate(&c, &seen[..2]).expect("two cameras");
         assert!((x - p.0).abs() < 1e-9 && (y - p.1).abs() < 1e-9);
         let (x, y) = locate(&c, &seen).expect("four cameras");
@@ -257,7 +289,11 @@ mod tests {
         for i in 0..5 {
             for j in 0..3 {
                 let p = (1.5 + 1.7 * i as f64, 1.0 + 1.4 * j as f64);
-                let seen = truth.iter().enumerate().map(|(k, c)| (k, c.column((p.1 - c.y).atan2(p.0 - c.x)))).collect();
+                let seen = truth
+                    .iter()
+                    .enumerate()
+                    .map(|(k, c)| (k, c.column((p.1 - c.y).atan2(p.0 - c.x))))
+                    .collect();
                 samples.push(Sample { seen, known: p });
             }
         }
@@ -266,7 +302,12 @@ mod tests {
         assert!(before > 0.1, "{before}");
         assert!(after < 2e-3, "d̄ after calibration {after}");
         for (e, t) in est.iter().zip(&truth) {
-            assert!(wrap(e.alpha - t.alpha).abs() < 0.3f64.to_radians(), "{} vs {}", e.alpha, t.alpha);
+            assert!(
+                wrap(e.alpha - t.alpha).abs() < 0.3f64.to_radians(),
+                "{} vs {}",
+                e.alpha,
+                t.alpha
+            );
             assert!((e.x - t.x).abs() < 0.02 && (e.y - t.y).abs() < 0.02);
             assert!((e.range - t.range).abs() < 0.5f64.to_radians());
         }
@@ -281,10 +322,19 @@ mod tests {
             }
         }
         let b = find_hue_blob(&img, (90.0, 150.0), 0.45, 0.25, 5).expect("blob");
-        assert!((b.u - 13.0).abs() < 1e-9 && (b.v - 7.0).abs() < 1e-9 && b.area == 24 && !b.touches_border);
+        assert!(
+            (b.u - 13.0).abs() < 1e-9
+                && (b.v - 7.0).abs() < 1e-9
+                && b.area == 24
+                && !b.touches_border
+        );
         for y in 0..4 {
             img.put_pixel(39, y, image::Rgb([30, 200, 40]));
         }
-        assert!(find_hue_blob(&img, (90.0, 150.0), 0.45, 0.25, 5).expect("blob").touches_border);
+        assert!(
+            find_hue_blob(&img, (90.0, 150.0), 0.45, 0.25, 5)
+                .expect("blob")
+                .touches_border
+        );
     }
 }

@@ -190,10 +190,18 @@ pub fn render_text(r: &Report) -> String {
         let _ = writeln!(o, "  ({} invalid transforms skipped)", r.tf_skipped_invalid);
     }
     if r.tf_static_and_dynamic > 0 {
-        let _ = writeln!(o, "  (warning: {} transforms for frames on both /tf and /tf_static; the moving samples win)", r.tf_static_and_dynamic);
+        let _ = writeln!(
+            o,
+            "  (warning: {} transforms for frames on both /tf and /tf_static; the moving samples win)",
+            r.tf_static_and_dynamic
+        );
     }
     if r.tf_reparented > 0 {
-        let _ = writeln!(o, "  (warning: frames changed parent {} times; the newest parent wins)", r.tf_reparented);
+        let _ = writeln!(
+            o,
+            "  (warning: frames changed parent {} times; the newest parent wins)",
+            r.tf_reparented
+        );
     }
     for (name, entries) in &r.metadata {
         let _ = writeln!(o, "metadata {name}:");

@@ -71,8 +71,13 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         )
     })?;
     let bytes = std::fs::read(model).with_context(|| format!("reading {model}"))?;
-    atomic::write_atomic(&a.output, &bytes, None).with_context(|| format!("writing {}", a.output.display()))?;
-    writeln!(out, "{}: trained on {} sessions in {:.1} s", s.pipeline, s.sessions, s.seconds)?;
+    atomic::write_atomic(&a.output, &bytes, None)
+        .with_context(|| format!("writing {}", a.output.display()))?;
+    writeln!(
+        out,
+        "{}: trained on {} sessions in {:.1} s",
+        s.pipeline, s.sessions, s.seconds
+    )?;
     writeln!(out, "  model  {}", a.output.display())?;
     for (t, p) in &s.tables {
         writeln!(out, "  {}  {t}", a.out.join(p).display())?;

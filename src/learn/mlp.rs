@@ -33,7 +33,11 @@ pub struct Mlp {
 impl Mlp {
     /// Weights uniform in ±0.5 from `rng`.
     pub fn new(inputs: usize, hidden: usize, rng: &mut ChaCha8Rng) -> Mlp {
-        let mut w = |n: usize| (0..n).map(|_| rng.random::<f64>() - 0.5).collect::<Vec<_>>();
+        let mut w = |n: usize| {
+            (0..n)
+                .map(|_| rng.random::<f64>() - 0.5)
+                .collect::<Vec<_>>()
+        };
         Mlp {
             inputs,
             hidden,
@@ -45,7 +49,12 @@ impl Mlp {
     fn hidden_out(&self, x: &[f64], h: &mut [f64]) {
         for (j, hj) in h.iter_mut().enumerate() {
             let row = &self.w1[j * (self.inputs + 1)..(j + 1) * (self.inputs + 1)];
-            let a: f64 = row[..self.inputs].iter().zip(x).map(|(w, v)| w * v).sum::<f64>() + row[self.inputs];
+            let a: f64 = row[..self.inputs]
+                .iter()
+                .zip(x)
+                .map(|(w, v)| w * v)
+                .sum::<f64>()
+                + row[self.inputs];
             *hj = sigmoid(a);
         }
     }
@@ -57,10 +66,12 @@ impl Mlp {
     }
 
     /// One gradient step on one sample (loss ½(y − ŷ)²).
+    #[allow(clippy::needless_range_loop)] // j indexes w1 rows, w2 and h together
     pub fn step(&mut self, x: &[f64], y: f64, lr: f64) {
         let mut h = vec![0.0; self.hidden];
         self.hidden_out(x, &mut h);
-        let out: f64 = h.iter().zip(&self.w2).map(|(a, w)| a * w).sum::<f64>() + self.w2[self.hidden];
+        let out: f64 =
+            h.iter().zip(&self.w2).map(|(a, w)| a * w).sum::<f64>() + self.w2[self.hidden];
         let err = out - y;
         for j in 0..self.hidden {
             let delta = err * self.w2[j] * h[j] * (1.0 - h[j]);
@@ -77,7 +88,14 @@ impl Mlp {
     }
 
     /// `epochs` passes over the samples in a fresh random order each time.
-    pub fn train(&mut self, xs: &[Vec<f64>], ys: &[f64], lr: f64, epochs: usize, rng: &mut ChaCha8Rng) {
+    pub fn train(
+        &mut self,
+        xs: &[Vec<f64>],
+        ys: &[f64],
+        lr: f64,
+        epochs: usize,
+        rng: &mut ChaCha8Rng,
+    ) {
         let mut order: Vec<usize> = (0..xs.len()).collect();
         for _ in 0..epochs {
             order.shuffle(rng);
@@ -192,10 +210,26 @@ mod tests {
     fn learns_a_known_smooth_function() {
         let mut r = rng::stream(2, "t", 0);
         let f = |x: &[f64]| (2.0 * x[0]).sin() + 0.5 * x[1] * x[1] - 0.3 * x[2];
-        let pts: Vec<Vec<f64>> = (0..600).map(|_| (0..3).map(|_| r.random::<f64>()).collect()).collect();
+        let pts: Vec<Vec<f64>> = (0..600)
+            .map(|_| (0..3).map(|_| r.random::<f64>()).collect())
+            .collect();
         let ys: Vec<f64> = pts.iter().map(|p| f(p)).collect();
-        let model = Regressor::fit(&pts[..400], &ys[..400], TrainSpec { hidden: 6, learning_rate: 0.3, epochs: 1500 }, &mut r);
-        let mse: f64 = pts[400..].iter().zip(&ys[400..]).map(|(p, y)| (model.predict(p) - y).powi(2)).sum::<f64>() / 200.0;
+        let model = Regressor::fit(
+            &pts[..400],
+            &ys[..400],
+            TrainSpec {
+                hidden: 6,
+                learning_rate: 0.3,
+                epochs: 1500,
+            },
+            &mut r,
+        );
+        let mse: f64 = pts[400..]
+            .iter()
+            .zip(&ys[400..])
+            .map(|(p, y)| (model.predict(p) - y).powi(2))
+            .sum::<f64>()
+            / 200.0;
         assert!(mse.sqrt() < 0.03, "rmse {}", mse.sqrt());
     }
 }

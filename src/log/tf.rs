@@ -408,7 +408,10 @@ mod tests {
         for static_first in [true, false] {
             let mut b = TfBuffer::new(0.0);
             let stat = tf("map", "odom", 0, [0.0; 3], 0.0);
-            let moving = [tf("map", "odom", 0, [5.0, 0.0, 0.0], 0.0), tf("map", "odom", 10, [7.0, 0.0, 0.0], 0.0)];
+            let moving = [
+                tf("map", "odom", 0, [5.0, 0.0, 0.0], 0.0),
+                tf("map", "odom", 10, [7.0, 0.0, 0.0], 0.0),
+            ];
             if static_first {
                 b.insert(&stat, true);
             }
@@ -419,8 +422,15 @@ mod tests {
                 b.insert(&stat, true);
             }
             let m = b.lookup("map", "odom", Nanos(5)).expect("moving edge");
-            assert!((m.translation.vector.x - 6.0).abs() < 1e-12, "static_first {static_first}: {m}");
-            assert_eq!(b.stats().static_and_dynamic, 1, "static_first {static_first}");
+            assert!(
+                (m.translation.vector.x - 6.0).abs() < 1e-12,
+                "static_first {static_first}: {m}"
+            );
+            assert_eq!(
+                b.stats().static_and_dynamic,
+                1,
+                "static_first {static_first}"
+            );
         }
     }
 }

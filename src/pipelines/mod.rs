@@ -10,7 +10,10 @@ use std::path::Path;
 use crate::run::{Experiment, RunOptions, RunSummary, config, run_experiment, unknown_kind};
 
 /// Every `pipeline.kind` this build knows.
-pub const KINDS: &[&str] = &[dataset_quality::DatasetQuality::KIND, omni_appearance::OmniAppearance::KIND];
+pub const KINDS: &[&str] = &[
+    dataset_quality::DatasetQuality::KIND,
+    omni_appearance::OmniAppearance::KIND,
+];
 
 /// Run one pipeline file, dispatching on its `kind`.
 pub fn run_file(path: &Path, opts: &RunOptions) -> anyhow::Result<RunSummary> {
@@ -34,10 +37,14 @@ mod tests {
     /// inputs) for any reason but an unknown kind.
     #[test]
     fn every_listed_kind_is_dispatched() {
-        let dir = tempfile::tempdir().unwrap();
+        let dir = tempfile::tempdir().expect("tempdir");
         for kind in KINDS {
             let path = dir.path().join(format!("{kind}.toml"));
-            std::fs::write(&path, format!("[pipeline]\nname = \"x\"\nkind = \"{kind}\"\n")).unwrap();
+            std::fs::write(
+                &path,
+                format!("[pipeline]\nname = \"x\"\nkind = \"{kind}\"\n"),
+            )
+            .expect("write");
             let opts = RunOptions {
                 sessions: None,
                 dry_run: false,

@@ -37,7 +37,9 @@ use crate::groundtruth::{PEOPLE_TOPIC, PeopleFrame, TARGETS_TOPIC, TargetsFrame}
 use crate::learn::mlp::{Regressor, TrainSpec};
 use crate::log::msgs::{CameraInfo, CompressedImage, Image};
 use crate::log::{SessionLog, TfBuffer, read_topic};
-use crate::report::figure::{Circle, FigureKind, LinePlot, Mark, ScatterPlot, Sensor, Series, TopView};
+use crate::report::figure::{
+    Circle, FigureKind, LinePlot, Mark, ScatterPlot, Sensor, Series, TopView,
+};
 use crate::report::{Figure, Table};
 use crate::run::config::Invalid;
 use crate::run::{Aggregate, Experiment, Frames, Products, Session, Stage};
@@ -138,20 +140,27 @@ fn image_topic(log: &SessionLog, name: &str) -> Option<(String, bool)> {
 }
 
 /// Every frame of a camera as `(header stamp ns, RGB image)`.
-fn for_each_frame(log: &SessionLog, name: &str, mut f: impl FnMut(i64, RgbImage) -> anyhow::Result<()>) -> anyhow::Result<()> {
-    let (topic, compressed) = image_topic(log, name).with_context(|| format!("no image topic for camera `{name}`"))?;
+fn for_each_frame(
+    log: &SessionLog,
+    name: &str,
+    mut f: impl FnMut(i64, RgbImage) -> anyhow::Result<()>,
+) -> anyhow::Result<()> {
+    let (topic, compressed) =
+        image_topic(log, name).with_context(|| format!("no image topic for camera `{name}`"))?;
     if compressed {
         for item in read_topic::<CompressedImage>(log, &topic)? {
             let (_, m) = item?;
             let stamp = m.header.stamp.nanos().map_or(0, |n| n.0 as i64);
-            let img = crate::log::image::decode_compressed(&m).with_context(|| format!("{topic} at {stamp} ns"))?;
+            let img = crate::log::image::decode_compressed(&m)
+                .with_context(|| format!("{topic} at {stamp} ns"))?;
             f(stamp, img.to_rgb8())?;
         }
     } else {
         for item in read_topic::<Image>(log, &topic)? {
             let (_, m) = item?;
             let stamp = m.header.stamp.nanos().map_or(0, |n| n.0 as i64);
-            let img = crate::log::image::decode_raw(&m).with_context(|| format!("{topic} at {stamp} ns"))?;
+            let img = crate::log::image::decode_raw(&m)
+                .with_context(|| format!("{topic} at {stamp} ns"))?;
             f(stamp, img.to_rgb8())?;
         }
     }
@@ -160,7 +169,9 @@ fn for_each_frame(log: &SessionLog, name: &str, mut f: impl FnMut(i64, RgbImage)
 
 fn first_info(log: &SessionLog, name: &str) -> anyhow::Result<CameraInfo> {
     let topic = format!("/{name}/camera_info");
-    let (_, info) = read_topic::<CameraInfo>(log, &topic)?.next().with_context(|| format!("{topic} has no messages"))??;
+    let (_, info) = read_topic::<CameraInfo>(log, &topic)?
+        .next()
+        .with_context(|| format!("{topic} has no messages"))??;
     Ok(info)
 }
 
@@ -172,7 +183,10 @@ impl Experiment for OmniAppearance {
     fn validate(p: &Params) -> Vec<Invalid> {
         let mut out = Vec::new();
         if !(p.train_fraction > 0.0 && p.train_fraction < 1.0) {
-            out.push(("train_fraction".into(), format!("{} is not in (0, 1)", p.train_fraction)));
+            out.push((
+                "train_fraction".into(),
+                format!("{} is not in (0, 1)", p.train_fraction),
+            ));
         }
         if p.webcams.len() == 1 || p.webcams.is_empty() && p.model.is_empty() {
             out.push((
@@ -181,13 +195,22 @@ impl Experiment for OmniAppearance {
             ));
         }
         if p.hidden_units == 0 || p.sweep_hidden.contains(&0) {
-            out.push(("hidden_units".into(), "a network needs at least one hidden unit".into()));
+            out.push((
+                "hidden_units".into(),
+                "a network needs at least one hidden unit".into(),
+            ));
         }
         if !(p.learning_rate > 0.0 && p.learning_rate < 10.0) {
-            out.push(("learning_rate".into(), format!("{} is not in (0, 10)", p.learning_rate)));
+            out.push((
+                "learning_rate".into(),
+                format!("{} is not in (0, 10)", p.learning_rate),
+            ));
         }
         if p.background_frames < 2 {
-            out.push(("background_frames".into(), "the background needs at least 2 frames".into()));
+            out.push((
+                "background_frames".into(),
+                "the background needs at least 2 frames".into(),
+            ));
         }
         if !(p.inner_radius > 0.0 && p.inner_radius < 1.0) {
             out.push(("inner_radius".into(), "must be a fraction in (0, 1)".into()));
@@ -199,7 +222,11 @@ impl Experiment for OmniAppearance {
         vec![
             Stage {
                 name: "hat detection (webcams)".into(),
-                requires: p.webcams.iter().map(|c| format!("/{c}/camera_info")).collect(),
+                requires: p
+                    .webcams
+                    .iter()
+                    .map(|c| format!("/{c}/camera_info"))
+                    .collect(),
                 optional: vec![TARGETS_TOPIC.into()],
             },
             Stage {
@@ -210,17 +237,38 @@ impl Experiment for OmniAppearance {
         ]
     }
 
-    fn process(s: &Session, p: &Params, _: &BTreeMap<String, String>, bar: &ProgressBar) -> anyhow::Result<Frames> {
+    fn process(
+        s: &Session,
+        p: &Params,
+        _: &BTreeMap<String, String>,
+        bar: &ProgressBar,
+    ) -> anyhow::Result<Frames> {
         let log = &s.log;
         let tf = TfBuffer::from_log(log, 1e6)?;
-        let t0 = log.summary().statistics.as_ref().map_or(crate::Nanos(0), |st| st.start);
+        let t0 = log
+            .summary()
+            .statistics
+            .as_ref()
+            .map_or(crate::Nanos(0), |st| st.start);
         bar.set_length((p.webcams.len() + 1) as u64);
         // webcams: nominal parameters from TF and camera_info, then hat detections
-        let (mut cam_rows, mut hats) = (Vec::new(), (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new()));
+        let (mut cam_rows, mut hats) = (
+            Vec::new(),
+            (
+                Vec::new(),
+                Vec::new(),
+                Vec::new(),
+                Vec::new(),
+                Vec::new(),
+                Vec::new(),
+            ),
+        );
         for (k, name) in p.webcams.iter().enumerate() {
             bar.set_message(format!("hats in {name}"));
             let info = first_info(log, name)?;
-            let pose = tf.lookup("map", name, t0).with_context(|| format!("no transform map <- {name}"))?;
+            let pose = tf
+                .lookup("map", name, t0)
+                .with_context(|| format!("no transform map <- {name}"))?;
             let z = pose.rotation * nalgebra::Vector3::z();
             cam_rows.push((
                 name.clone(),
@@ -231,7 +279,13 @@ impl Experiment for OmniAppearance {
                 f64::from(info.width),
             ));
             for_each_frame(log, name, |stamp, img| {
-                if let Some(b) = external::find_hue_blob(&img, (p.hat_hue_deg[0], p.hat_hue_deg[1]), p.hat_min_saturation, p.hat_min_value, p.hat_min_area) {
+                if let Some(b) = external::find_hue_blob(
+                    &img,
+                    (p.hat_hue_deg[0], p.hat_hue_deg[1]),
+                    p.hat_min_saturation,
+                    p.hat_min_value,
+                    p.hat_min_area,
+                ) {
                     hats.0.push(stamp);
                     hats.1.push(k as i64);
                     hats.2.push(b.u);
@@ -258,7 +312,8 @@ impl Experiment for OmniAppearance {
         if log.summary().channel(TARGETS_TOPIC).is_some() {
             for m in log.messages_on(&[TARGETS_TOPIC])? {
                 let m = m?;
-                let f: TargetsFrame = serde_json::from_slice(&m.data).with_context(|| format!("{TARGETS_TOPIC} at {} s", m.log_time))?;
+                let f: TargetsFrame = serde_json::from_slice(&m.data)
+                    .with_context(|| format!("{TARGETS_TOPIC} at {} s", m.log_time))?;
                 for t in f.targets {
                     tg_t.push(f.stamp_ns as i64);
                     tg_x.push(t.x);
@@ -267,11 +322,13 @@ impl Experiment for OmniAppearance {
             }
         }
         let targets = df! { "stamp" => tg_t, "x" => tg_x, "y" => tg_y }?;
-        let (mut tr_t, mut tr_id, mut tr_x, mut tr_y) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut tr_t, mut tr_id, mut tr_x, mut tr_y) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         if log.summary().channel(PEOPLE_TOPIC).is_some() {
             for m in log.messages_on(&[PEOPLE_TOPIC])? {
                 let m = m?;
-                let f: PeopleFrame = serde_json::from_slice(&m.data).with_context(|| format!("{PEOPLE_TOPIC} at {} s", m.log_time))?;
+                let f: PeopleFrame = serde_json::from_slice(&m.data)
+                    .with_context(|| format!("{PEOPLE_TOPIC} at {} s", m.log_time))?;
                 for q in f.people {
                     tr_t.push(f.stamp_ns as i64);
                     tr_id.push(i64::from(q.id));
@@ -282,12 +339,17 @@ impl Experiment for OmniAppearance {
         }
         let truth = df! { "stamp" => tr_t, "id" => tr_id, "x" => tr_x, "y" => tr_y }?;
         let camera_truth = {
-            let meta = log.summary().metadata.iter().find(|m| m.name == "peopletrack.truth");
+            let meta = log
+                .summary()
+                .metadata
+                .iter()
+                .find(|m| m.name == "peopletrack.truth");
             let list: Vec<serde_json::Value> = meta
                 .and_then(|m| m.entries.get("cameras"))
                 .and_then(|c| serde_json::from_str(c).ok())
                 .unwrap_or_default();
-            let get = |v: &serde_json::Value, k: &str, i: usize| v[k][i].as_f64().unwrap_or(f64::NAN);
+            let get =
+                |v: &serde_json::Value, k: &str, i: usize| v[k][i].as_f64().unwrap_or(f64::NAN);
             df! {
                 "camera" => list.iter().map(|v| v["name"].as_str().unwrap_or_default().to_string()).collect::<Vec<_>>(),
                 "true_x" => list.iter().map(|v| get(v, "true_xyz", 0)).collect::<Vec<_>>(),
@@ -299,18 +361,38 @@ impl Experiment for OmniAppearance {
         // omni: unwrap, background, features
         bar.set_message("omni features");
         let info = first_info(log, &p.omni)?;
-        let model = CameraModel::from_camera_info(&info).with_context(|| format!("/{}/camera_info", p.omni))?;
+        let model = CameraModel::from_camera_info(&info)
+            .with_context(|| format!("/{}/camera_info", p.omni))?;
         let (xc, yc, rim) = match &model {
             CameraModel::ConicalMirror(c) => (c.xc, c.yc, c.r_rim()),
             CameraModel::Paracatadioptric(c) => (c.xc, c.yc, c.r_max),
-            CameraModel::Pinhole(_) => anyhow::bail!("camera `{}` is a pinhole, not an omnidirectional camera", p.omni),
+            CameraModel::Pinhole(_) => anyhow::bail!(
+                "camera `{}` is a pinhole, not an omnidirectional camera",
+                p.omni
+            ),
         };
-        let unwrap = Unwrapper::new(xc, yc, p.inner_radius * rim, rim, p.panorama[0], p.panorama[1]);
-        let omni_pose = tf.lookup("map", &p.omni, t0).with_context(|| format!("no transform map <- {}", p.omni))?;
+        let unwrap = Unwrapper::new(
+            xc,
+            yc,
+            p.inner_radius * rim,
+            rim,
+            p.panorama[0],
+            p.panorama[1],
+        );
+        let omni_pose = tf
+            .lookup("map", &p.omni, t0)
+            .with_context(|| format!("no transform map <- {}", p.omni))?;
         let ox = omni_pose.rotation * nalgebra::Vector3::x();
         let mut bg_frames: Vec<Vec<f32>> = Vec::new();
         let mut background: Option<Background> = None;
-        let mut om = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut om = (
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+        );
         for_each_frame(log, &p.omni, |stamp, img| {
             let pano = unwrap.unwrap_grey(&img);
             if background.is_none() {
@@ -373,13 +455,23 @@ struct Row {
 /// Run the position Kalman filter (eq. 1–9) over appearance-model positions `z`; `starts[i]`
 /// restarts it (a new session or a gap). With `velocity`, u_k is the difference of the last two
 /// estimates (the paper's "estimated velocity of the person"); without, u_k = 0.
-fn kalman_track(z: &[Vector2<f64>], starts: &[bool], q: Matrix2<f64>, r: Matrix2<f64>, velocity: bool) -> Vec<Vector2<f64>> {
+fn kalman_track(
+    z: &[Vector2<f64>],
+    starts: &[bool],
+    q: Matrix2<f64>,
+    r: Matrix2<f64>,
+    velocity: bool,
+) -> Vec<Vector2<f64>> {
     let mut est = vec![Vector2::zeros(); z.len()];
     let mut kf: Option<PositionKf> = None;
     for i in 0..z.len() {
         match kf.as_mut() {
             Some(k) if !starts[i] => {
-                let u = if velocity && i >= 2 && !starts[i - 1] { est[i - 1] - est[i - 2] } else { Vector2::zeros() };
+                let u = if velocity && i >= 2 && !starts[i - 1] {
+                    est[i - 1] - est[i - 2]
+                } else {
+                    Vector2::zeros()
+                };
                 k.predict(u);
                 k.correct(z[i]);
             }
@@ -392,18 +484,39 @@ fn kalman_track(z: &[Vector2<f64>], starts: &[bool], q: Matrix2<f64>, r: Matrix2
 
 /// Per-frame estimates of the appearance model on every omni frame with a person: session,
 /// stamp, bearing (deg, map frame), distance (m) and position (m, map frame), as CSV.
+#[allow(clippy::type_complexity)]
 fn estimates_csv(ctx: &Aggregate, omni: &DataFrame, model: &Regressor) -> anyhow::Result<Vec<u8>> {
-    let mut cols: (Vec<String>, Vec<i64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) = Default::default();
+    let mut cols: (
+        Vec<String>,
+        Vec<i64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+    ) = Default::default();
     if omni.height() > 0 {
-        let (ss, st, valid) = (i64s(omni, "session")?, i64s(omni, "stamp")?, bools(omni, "valid")?);
-        let (w, a, px, ang) = (f64s(omni, "width")?, f64s(omni, "apparent_distance")?, f64s(omni, "pixels")?, f64s(omni, "angle")?);
+        let (ss, st, valid) = (
+            i64s(omni, "session")?,
+            i64s(omni, "stamp")?,
+            bools(omni, "valid")?,
+        );
+        let (w, a, px, ang) = (
+            f64s(omni, "width")?,
+            f64s(omni, "apparent_distance")?,
+            f64s(omni, "pixels")?,
+            f64s(omni, "angle")?,
+        );
         for i in 0..ss.len() {
             if !valid[i] {
                 continue;
             }
             let (session, frames) = &ctx.sessions[ss[i] as usize];
             let pose = frames.get("omni_pose").context("no omni pose")?;
-            let (cx, cy, yaw) = (f64s(pose, "x")?[0], f64s(pose, "y")?[0], f64s(pose, "yaw")?[0]);
+            let (cx, cy, yaw) = (
+                f64s(pose, "x")?[0],
+                f64s(pose, "y")?[0],
+                f64s(pose, "yaw")?[0],
+            );
             let d = model.predict(&[w[i], a[i], px[i]]);
             let b = external::wrap(yaw + ang[i]);
             cols.0.push(session.path.display().to_string());
@@ -429,15 +542,23 @@ fn mean_std(v: &[f64]) -> (f64, f64) {
     }
 }
 
-#[allow(clippy::too_many_lines)]
+#[allow(clippy::too_many_lines, clippy::type_complexity)]
 fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     let mut out = Products::default();
     let loaded: Option<AppearanceModel> = if p.model.is_empty() {
         None
     } else {
-        let text = std::fs::read_to_string(&p.model).with_context(|| format!("reading model {}", p.model))?;
-        let m: AppearanceModel = serde_json::from_str(&text).with_context(|| format!("model {} is not an appearance model", p.model))?;
-        anyhow::ensure!(m.kind == OmniAppearance::KIND, "model {} is a `{}` model, not `{}`", p.model, m.kind, OmniAppearance::KIND);
+        let text = std::fs::read_to_string(&p.model)
+            .with_context(|| format!("reading model {}", p.model))?;
+        let m: AppearanceModel = serde_json::from_str(&text)
+            .with_context(|| format!("model {} is not an appearance model", p.model))?;
+        anyhow::ensure!(
+            m.kind == OmniAppearance::KIND,
+            "model {} is a `{}` model, not `{}`",
+            p.model,
+            m.kind,
+            OmniAppearance::KIND
+        );
         Some(m)
     };
     let get = |name: &str| -> anyhow::Result<DataFrame> {
@@ -458,26 +579,60 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     };
     if p.webcams.is_empty() {
         // no measurement system: only estimate positions with the loaded model
-        let model = loaded.as_ref().context("no webcams and no model: nothing to do")?;
-        out.artifacts.push(("estimates.csv".into(), estimates_csv(ctx, &get("omni")?, &model.regressor)?));
-        out.summary.push(format!("Positions estimated with {} written to out/omni_appearance/estimates.csv.", p.model));
+        let model = loaded
+            .as_ref()
+            .context("no webcams and no model: nothing to do")?;
+        out.artifacts.push((
+            "estimates.csv".into(),
+            estimates_csv(ctx, &get("omni")?, &model.regressor)?,
+        ));
+        out.summary.push(format!(
+            "Positions estimated with {} written to out/omni_appearance/estimates.csv.",
+            p.model
+        ));
         return Ok(out);
     }
-    let cameras = ctx.sessions.first().and_then(|(_, f)| f.get("cameras")).context("no camera table")?;
+    let cameras = ctx
+        .sessions
+        .first()
+        .and_then(|(_, f)| f.get("cameras"))
+        .context("no camera table")?;
     let names = strs(cameras, "camera")?;
     let nominal: Vec<BearingCamera> = {
-        let (x, y, h, r, w) = (f64s(cameras, "x")?, f64s(cameras, "y")?, f64s(cameras, "heading")?, f64s(cameras, "range")?, f64s(cameras, "width")?);
-        (0..names.len()).map(|i| BearingCamera { alpha: h[i], x: x[i], y: y[i], range: r[i], width: w[i] }).collect()
+        let (x, y, h, r, w) = (
+            f64s(cameras, "x")?,
+            f64s(cameras, "y")?,
+            f64s(cameras, "heading")?,
+            f64s(cameras, "range")?,
+            f64s(cameras, "width")?,
+        );
+        (0..names.len())
+            .map(|i| BearingCamera {
+                alpha: h[i],
+                x: x[i],
+                y: y[i],
+                range: r[i],
+                width: w[i],
+            })
+            .collect()
     };
     let hats = get("hats")?;
     let targets = get("targets")?;
     // hat detections per (session, stamp): cameras that see the whole hat
     let mut seen: BTreeMap<(i64, i64), Vec<(usize, f64)>> = BTreeMap::new();
     if hats.height() > 0 {
-        let (ss, st, sc, su, sw) = (i64s(&hats, "session")?, i64s(&hats, "stamp")?, i64s(&hats, "camera")?, f64s(&hats, "u")?, bools(&hats, "whole")?);
+        let (ss, st, sc, su, sw) = (
+            i64s(&hats, "session")?,
+            i64s(&hats, "stamp")?,
+            i64s(&hats, "camera")?,
+            f64s(&hats, "u")?,
+            bools(&hats, "whole")?,
+        );
         for i in 0..ss.len() {
             if sw[i] {
-                seen.entry((ss[i], st[i])).or_default().push((sc[i] as usize, su[i]));
+                seen.entry((ss[i], st[i]))
+                    .or_default()
+                    .push((sc[i] as usize, su[i]));
             }
         }
     }
@@ -485,38 +640,79 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     // 1. calibration of the measurement system
     let mut samples = Vec::new();
     if targets.height() > 0 {
-        let (ss, st, tx, ty) = (i64s(&targets, "session")?, i64s(&targets, "stamp")?, f64s(&targets, "x")?, f64s(&targets, "y")?);
+        let (ss, st, tx, ty) = (
+            i64s(&targets, "session")?,
+            i64s(&targets, "stamp")?,
+            f64s(&targets, "x")?,
+            f64s(&targets, "y")?,
+        );
         for i in 0..ss.len() {
             if let Some(v) = seen.get(&(ss[i], st[i]))
                 && v.len() >= 2
             {
-                samples.push(Sample { seen: v.clone(), known: (tx[i], ty[i]) });
+                samples.push(Sample {
+                    seen: v.clone(),
+                    known: (tx[i], ty[i]),
+                });
             }
         }
     }
     let d_before = external::mean_distance(&nominal, &samples);
     let (cams, d_after) = if samples.len() >= 4 {
-        external::calibrate(&nominal, &samples).map_err(|e| anyhow::anyhow!("calibration failed: {e}"))?
+        external::calibrate(&nominal, &samples)
+            .map_err(|e| anyhow::anyhow!("calibration failed: {e}"))?
     } else {
-        out.summary.push(format!("Only {} calibration samples: the nominal camera parameters are used uncalibrated.", samples.len()));
+        out.summary.push(format!(
+            "Only {} calibration samples: the nominal camera parameters are used uncalibrated.",
+            samples.len()
+        ));
         (nominal.clone(), d_before)
     };
     {
-        let truth = ctx.sessions.first().and_then(|(_, f)| f.get("camera_truth")).cloned().unwrap_or_default();
-        let tnames = if truth.height() > 0 { strs(&truth, "camera")? } else { Vec::new() };
+        let truth = ctx
+            .sessions
+            .first()
+            .and_then(|(_, f)| f.get("camera_truth"))
+            .cloned()
+            .unwrap_or_default();
+        let tnames = if truth.height() > 0 {
+            strs(&truth, "camera")?
+        } else {
+            Vec::new()
+        };
         let (tx, ty, tyaw) = if truth.height() > 0 {
-            (f64s(&truth, "true_x")?, f64s(&truth, "true_y")?, f64s(&truth, "true_yaw_deg")?)
+            (
+                f64s(&truth, "true_x")?,
+                f64s(&truth, "true_y")?,
+                f64s(&truth, "true_yaw_deg")?,
+            )
         } else {
             (Vec::new(), Vec::new(), Vec::new())
         };
-        let mut rows: (Vec<String>, Vec<String>, Vec<f64>, Vec<f64>, Vec<Option<f64>>) = Default::default();
+        let mut rows: (
+            Vec<String>,
+            Vec<String>,
+            Vec<f64>,
+            Vec<f64>,
+            Vec<Option<f64>>,
+        ) = Default::default();
         for (i, n) in names.iter().enumerate() {
             let t = tnames.iter().position(|x| x == n);
             for (param, nom, est, tru) in [
-                ("alpha (deg)", nominal[i].alpha.to_degrees(), cams[i].alpha.to_degrees(), t.map(|k| tyaw[k])),
+                (
+                    "alpha (deg)",
+                    nominal[i].alpha.to_degrees(),
+                    cams[i].alpha.to_degrees(),
+                    t.map(|k| tyaw[k]),
+                ),
                 ("X (m)", nominal[i].x, cams[i].x, t.map(|k| tx[k])),
                 ("Y (m)", nominal[i].y, cams[i].y, t.map(|k| ty[k])),
-                ("delta alpha (deg)", nominal[i].range.to_degrees(), cams[i].range.to_degrees(), None),
+                (
+                    "delta alpha (deg)",
+                    nominal[i].range.to_degrees(),
+                    cams[i].range.to_degrees(),
+                    None,
+                ),
             ] {
                 rows.0.push(n.clone());
                 rows.1.push(param.to_string());
@@ -539,27 +735,53 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
                     samples.len()
                 )),
         );
-        out.summary.push(format!("Calibration: d̄ {:.3} m → {:.3} m over {} samples (paper ≈ 0.01 m).", d_before, d_after, samples.len()));
+        out.summary.push(format!(
+            "Calibration: d̄ {:.3} m → {:.3} m over {} samples (paper ≈ 0.01 m).",
+            d_before,
+            d_after,
+            samples.len()
+        ));
     }
 
     // 2. external positions and the dataset
     let omni = get("omni")?;
-    let pose = ctx.sessions.first().and_then(|(_, f)| f.get("omni_pose")).context("no omni pose")?;
+    let pose = ctx
+        .sessions
+        .first()
+        .and_then(|(_, f)| f.get("omni_pose"))
+        .context("no omni pose")?;
     let cam_xy = (f64s(pose, "x")?[0], f64s(pose, "y")?[0]);
     let cam_yaw = f64s(pose, "yaw")?[0];
     let truth = get("truth")?;
     let mut truth_at: BTreeMap<(i64, i64), (i64, f64, f64)> = BTreeMap::new();
     if truth.height() > 0 {
-        let (ss, st, id, x, y) = (i64s(&truth, "session")?, i64s(&truth, "stamp")?, i64s(&truth, "id")?, f64s(&truth, "x")?, f64s(&truth, "y")?);
+        let (ss, st, id, x, y) = (
+            i64s(&truth, "session")?,
+            i64s(&truth, "stamp")?,
+            i64s(&truth, "id")?,
+            f64s(&truth, "x")?,
+            f64s(&truth, "y")?,
+        );
         for i in 0..ss.len() {
-            truth_at.entry((ss[i], st[i])).or_insert((id[i], x[i], y[i]));
+            truth_at
+                .entry((ss[i], st[i]))
+                .or_insert((id[i], x[i], y[i]));
         }
     }
     let mut rows: Vec<Row> = Vec::new();
     let mut ext_err_truth = Vec::new();
     {
-        let (ss, st, valid) = (i64s(&omni, "session")?, i64s(&omni, "stamp")?, bools(&omni, "valid")?);
-        let (w, a, px, ang) = (f64s(&omni, "width")?, f64s(&omni, "apparent_distance")?, f64s(&omni, "pixels")?, f64s(&omni, "angle")?);
+        let (ss, st, valid) = (
+            i64s(&omni, "session")?,
+            i64s(&omni, "stamp")?,
+            bools(&omni, "valid")?,
+        );
+        let (w, a, px, ang) = (
+            f64s(&omni, "width")?,
+            f64s(&omni, "apparent_distance")?,
+            f64s(&omni, "pixels")?,
+            f64s(&omni, "angle")?,
+        );
         let n_sessions = ctx.sessions.len();
         let mut first_stamp = vec![i64::MAX; n_sessions];
         let mut last_stamp = vec![i64::MIN; n_sessions];
@@ -568,7 +790,11 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             last_stamp[ss[i] as usize] = last_stamp[ss[i] as usize].max(st[i]);
         }
         for i in 0..ss.len() {
-            let Some(ext) = seen.get(&(ss[i], st[i])).filter(|v| v.len() >= 2).and_then(|v| external::locate(&cams, v)) else {
+            let Some(ext) = seen
+                .get(&(ss[i], st[i]))
+                .filter(|v| v.len() >= 2)
+                .and_then(|v| external::locate(&cams, v))
+            else {
                 continue;
             };
             let tr = truth_at.get(&(ss[i], st[i]));
@@ -600,7 +826,18 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             });
         }
     }
-    anyhow::ensure!(rows.len() >= 20, "only {} frames have both omni features and a measured position; need at least 20", rows.len());
+    if rows.len() < 20 {
+        let with_person = bools(&omni, "valid")?.iter().filter(|v| **v).count();
+        let measured = seen.values().filter(|v| v.len() >= 2).count();
+        anyhow::bail!(
+            "only {} frames have both omni features and a measured position; need at least 20 \
+             ({with_person} of {} omni frames show a person, {measured} webcam frames see the hat in ≥ 2 cameras; \
+             no person in any omni frame usually means one stood in the first {} frames, which are taken as the empty background)",
+            rows.len(),
+            omni.height(),
+            p.background_frames
+        );
+    }
     rows.sort_by_key(|r| (r.session, r.stamp));
     let (ext_m, ext_s) = mean_std(&ext_err_truth);
     if !ext_err_truth.is_empty() {
@@ -612,7 +849,14 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     }
 
     // angle error
-    let angle_err: Vec<f64> = rows.iter().map(|r| external::wrap(r.omni_bearing - r.bearing).abs().to_degrees()).collect();
+    let angle_err: Vec<f64> = rows
+        .iter()
+        .map(|r| {
+            external::wrap(r.omni_bearing - r.bearing)
+                .abs()
+                .to_degrees()
+        })
+        .collect();
     let (am, asd) = mean_std(&angle_err);
     out.tables.push(
         Table::new(
@@ -647,7 +891,11 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             FigureKind::Scatter(ScatterPlot {
                 x_label: "distance from the measurement system (m)".into(),
                 y_label: (*n).into(),
-                series: vec![Series::points("", dist.iter().copied().zip(x.iter().copied()).collect(), 5)],
+                series: vec![Series::points(
+                    "",
+                    dist.iter().copied().zip(x.iter().copied()).collect(),
+                    5,
+                )],
                 annotation: format!("r = {:.3}", c.r),
                 fit_line: true,
             }),
@@ -656,7 +904,11 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
 
     // 4. ANN protocol
     let xs: Vec<Vec<f64>> = rows.iter().map(|r| r.features.to_vec()).collect();
-    let spec = TrainSpec { hidden: p.hidden_units, learning_rate: p.learning_rate, epochs: p.epochs };
+    let spec = TrainSpec {
+        hidden: p.hidden_units,
+        learning_rate: p.learning_rate,
+        epochs: p.epochs,
+    };
     let split = |s: usize, idx: &[usize]| -> (Vec<usize>, Vec<usize>) {
         let mut r = rng::stream(p.seed, "split", s as u64);
         let mut v = idx.to_vec();
@@ -679,18 +931,33 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
                 Some(m) => m.regressor.clone(),
                 None => fit(&train, s as u64, spec),
             };
-            (s, test.iter().map(|i| (*i, (model.predict(&xs[*i]) - dist[*i]).abs())).collect())
+            (
+                s,
+                test.iter()
+                    .map(|i| (*i, (model.predict(&xs[*i]) - dist[*i]).abs()))
+                    .collect(),
+            )
         })
         .collect();
-    let split_stats: Vec<(f64, f64)> = per_split.iter().map(|(_, e)| mean_std(&e.iter().map(|x| x.1).collect::<Vec<_>>())).collect();
-    let pooled: Vec<f64> = per_split.iter().flat_map(|(_, e)| e.iter().map(|x| x.1)).collect();
+    let split_stats: Vec<(f64, f64)> = per_split
+        .iter()
+        .map(|(_, e)| mean_std(&e.iter().map(|x| x.1).collect::<Vec<_>>()))
+        .collect();
+    let pooled: Vec<f64> = per_split
+        .iter()
+        .flat_map(|(_, e)| e.iter().map(|x| x.1))
+        .collect();
     let (pm, ps) = mean_std(&pooled);
-    let best = (0..split_stats.len()).min_by(|a, b| split_stats[*a].0.total_cmp(&split_stats[*b].0)).unwrap_or(0);
-    let worst = (0..split_stats.len()).max_by(|a, b| split_stats[*a].0.total_cmp(&split_stats[*b].0)).unwrap_or(0);
+    let best = (0..split_stats.len())
+        .min_by(|a, b| split_stats[*a].0.total_cmp(&split_stats[*b].0))
+        .unwrap_or(0);
+    let worst = (0..split_stats.len())
+        .max_by(|a, b| split_stats[*a].0.total_cmp(&split_stats[*b].0))
+        .unwrap_or(0);
     out.tables.push(
         Table::new(
             "ann_error",
-            &format!(
+            format!(
                 "Appearance model (ANN 3-{}-1, learning rate {}) distance error over {} random {:.0}/{:.0} splits",
                 p.hidden_units,
                 p.learning_rate,
@@ -712,11 +979,17 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             "abs_error_m" => pooled.clone(),
         }?),
     );
-    out.summary.push(format!("ANN distance error {} m over {} splits (paper 0.126 ± 0.167).", fmt_ms(pm, ps), p.splits));
+    out.summary.push(format!(
+        "ANN distance error {} m over {} splits (paper 0.126 ± 0.167).",
+        fmt_ms(pm, ps),
+        p.splits
+    ));
     // ANN output vs distance (fig 5, bottom right): split 0's test predictions
     {
         let (train0, test0) = split(0, &all);
-        let m0 = loaded.as_ref().map_or_else(|| fit(&train0, 0, spec), |m| m.regressor.clone());
+        let m0 = loaded
+            .as_ref()
+            .map_or_else(|| fit(&train0, 0, spec), |m| m.regressor.clone());
         let pred: Vec<f64> = test0.iter().map(|i| m0.predict(&xs[*i])).collect();
         let truth0: Vec<f64> = test0.iter().map(|i| dist[*i]).collect();
         let c = stats::pearson(&pred, &truth0, 0.95)?;
@@ -731,7 +1004,11 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             FigureKind::Scatter(ScatterPlot {
                 x_label: "distance from the measurement system (m)".into(),
                 y_label: "appearance model output (m)".into(),
-                series: vec![Series::points("", truth0.iter().copied().zip(pred.iter().copied()).collect(), 5)],
+                series: vec![Series::points(
+                    "",
+                    truth0.iter().copied().zip(pred.iter().copied()).collect(),
+                    5,
+                )],
                 annotation: format!("r = {:.3}", c.r),
                 fit_line: true,
             }),
@@ -749,15 +1026,29 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
 
     // sweep
     if loaded.is_none() && !p.sweep_hidden.is_empty() {
-        let configs: Vec<(usize, f64)> = p.sweep_hidden.iter().flat_map(|h| p.sweep_learning_rates.iter().map(move |lr| (*h, *lr))).collect();
+        let configs: Vec<(usize, f64)> = p
+            .sweep_hidden
+            .iter()
+            .flat_map(|h| p.sweep_learning_rates.iter().map(move |lr| (*h, *lr)))
+            .collect();
         let results: Vec<(usize, f64, f64)> = configs
             .par_iter()
             .map(|&(h, lr)| {
                 let errs: Vec<f64> = (0..p.sweep_splits)
                     .flat_map(|s| {
                         let (train, test) = split(s, &all);
-                        let m = fit(&train, 1000 + s as u64, TrainSpec { hidden: h, learning_rate: lr, epochs: p.epochs });
-                        test.iter().map(|i| (m.predict(&xs[*i]) - dist[*i]).abs()).collect::<Vec<_>>()
+                        let m = fit(
+                            &train,
+                            1000 + s as u64,
+                            TrainSpec {
+                                hidden: h,
+                                learning_rate: lr,
+                                epochs: p.epochs,
+                            },
+                        );
+                        test.iter()
+                            .map(|i| (m.predict(&xs[*i]) - dist[*i]).abs())
+                            .collect::<Vec<_>>()
                     })
                     .collect();
                 (h, lr, mean_std(&errs).0)
@@ -770,7 +1061,11 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             .map(|(k, lr)| {
                 Series::line(
                     format!("learning rate {lr}"),
-                    results.iter().filter(|r| r.1 == *lr).map(|r| (r.0 as f64, r.2)).collect(),
+                    results
+                        .iter()
+                        .filter(|r| r.1 == *lr)
+                        .map(|r| (r.0 as f64, r.2))
+                        .collect(),
                     k + 1,
                 )
                 .with_mark(Mark::LinePoints)
@@ -779,7 +1074,12 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
         out.figures.push(Figure::new(
             "ann_sweep",
             "Mean test error by hidden units and learning rate",
-            FigureKind::Lines(LinePlot { x_label: "hidden units".into(), y_label: "mean distance error (m)".into(), series, ..Default::default() }),
+            FigureKind::Lines(LinePlot {
+                x_label: "hidden units".into(),
+                y_label: "mean distance error (m)".into(),
+                series,
+                ..Default::default()
+            }),
         ));
         let best_cfg = results.iter().min_by(|a, b| a.2.total_cmp(&b.2)).copied();
         if let Some((h, lr, e)) = best_cfg {
@@ -808,24 +1108,46 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
         let mut train_by = BTreeMap::new();
         let mut test_by = BTreeMap::new();
         for (k, pid) in pa.iter().enumerate() {
-            let idx: Vec<usize> = (0..rows.len()).filter(|i| rows[*i].person == *pid).collect();
+            let idx: Vec<usize> = (0..rows.len())
+                .filter(|i| rows[*i].person == *pid)
+                .collect();
             let (tr, te) = split(100 + k, &idx);
             train_by.insert(*pid, tr);
             test_by.insert(*pid, te);
         }
-        let models: BTreeMap<i64, Regressor> = pa.iter().map(|pid| (*pid, fit(&train_by[pid], 200 + *pid as u64, spec))).collect();
+        let models: BTreeMap<i64, Regressor> = pa
+            .iter()
+            .map(|pid| (*pid, fit(&train_by[pid], 200 + *pid as u64, spec)))
+            .collect();
         let union: Vec<usize> = pa.iter().flat_map(|pid| train_by[pid].clone()).collect();
         let general = fit(&union, 300, spec);
-        let err = |m: &Regressor, idx: &[usize]| idx.iter().map(|i| (m.predict(&xs[*i]) - dist[*i]).abs()).collect::<Vec<_>>();
-        let paper = [["0.096 ± 0.074", "0.133 ± 0.126"], ["0.231 ± 0.276", "0.117 ± 0.111"]];
-        let mut t: (Vec<String>, Vec<String>, Vec<String>, Vec<String>, Vec<String>) = Default::default();
+        let err = |m: &Regressor, idx: &[usize]| {
+            idx.iter()
+                .map(|i| (m.predict(&xs[*i]) - dist[*i]).abs())
+                .collect::<Vec<_>>()
+        };
+        let paper = [
+            ["0.096 ± 0.074", "0.133 ± 0.126"],
+            ["0.231 ± 0.276", "0.117 ± 0.111"],
+        ];
+        let mut t: (
+            Vec<String>,
+            Vec<String>,
+            Vec<String>,
+            Vec<String>,
+            Vec<String>,
+        ) = Default::default();
         let (mut specific, mut generic) = (Vec::new(), Vec::new());
         for (a, subject) in pa.iter().enumerate() {
             t.0.push(format!("person {subject}"));
             for (b, model_for) in pa.iter().enumerate() {
                 let e = err(&models[model_for], &test_by[subject]);
                 let (m, s) = mean_std(&e);
-                if b == 0 { t.1.push(fmt_ms(m, s)) } else { t.2.push(fmt_ms(m, s)) }
+                if b == 0 {
+                    t.1.push(fmt_ms(m, s))
+                } else {
+                    t.2.push(fmt_ms(m, s))
+                }
                 if a == b {
                     specific.extend(e);
                 }
@@ -870,14 +1192,20 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             fmt_ms(sm, ss),
             fmt_ms(gm, gs),
             tt.p_two_sided,
-            if tt.significant(0.01) { "significant" } else { "not significant" }
+            if tt.significant(0.01) {
+                "significant"
+            } else {
+                "not significant"
+            }
         ));
     }
 
     // 6. Kalman filter
     {
         let (train, test) = split(0, &all);
-        let model = loaded.as_ref().map_or_else(|| fit(&train, 0, spec), |m| m.regressor.clone());
+        let model = loaded
+            .as_ref()
+            .map_or_else(|| fit(&train, 0, spec), |m| m.regressor.clone());
         let in_train: Vec<bool> = {
             let mut v = vec![false; rows.len()];
             for i in &train {
@@ -890,33 +1218,54 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             .zip(&xs)
             .map(|(r, x)| {
                 let d = model.predict(x);
-                Vector2::new(r.cam.0 + d * r.omni_bearing.cos(), r.cam.1 + d * r.omni_bearing.sin())
+                Vector2::new(
+                    r.cam.0 + d * r.omni_bearing.cos(),
+                    r.cam.1 + d * r.omni_bearing.sin(),
+                )
             })
             .collect();
-        let ext: Vec<Vector2<f64>> = rows.iter().map(|r| Vector2::new(r.ext.0, r.ext.1)).collect();
+        let ext: Vec<Vector2<f64>> = rows
+            .iter()
+            .map(|r| Vector2::new(r.ext.0, r.ext.1))
+            .collect();
         // R: measurement errors on training frames; Q: deviations from constant velocity
-        let r_samples: Vec<Vector2<f64>> = (0..rows.len()).filter(|i| in_train[*i]).map(|i| z[i] - ext[i]).collect();
+        let r_samples: Vec<Vector2<f64>> = (0..rows.len())
+            .filter(|i| in_train[*i])
+            .map(|i| z[i] - ext[i])
+            .collect();
         let gap = (p.max_gap_s * 1e9) as i64;
-        let consecutive = |i: usize| i >= 2 && rows[i].session == rows[i - 2].session && rows[i].stamp - rows[i - 2].stamp <= 2 * gap;
+        let consecutive = |i: usize| {
+            i >= 2
+                && rows[i].session == rows[i - 2].session
+                && rows[i].stamp - rows[i - 2].stamp <= 2 * gap
+        };
         let q_samples: Vec<Vector2<f64>> = (2..rows.len())
             .filter(|i| in_train[*i] && consecutive(*i))
             .map(|i| ext[i] - ext[i - 1] - (ext[i - 1] - ext[i - 2]))
             .collect();
         let (q, r) = (covariance(&q_samples), covariance(&r_samples));
         let starts: Vec<bool> = (0..rows.len())
-            .map(|i| i == 0 || rows[i].session != rows[i - 1].session || rows[i].stamp - rows[i - 1].stamp > gap)
+            .map(|i| {
+                i == 0
+                    || rows[i].session != rows[i - 1].session
+                    || rows[i].stamp - rows[i - 1].stamp > gap
+            })
             .collect();
         let est = kalman_track(&z, &starts, q, r, true);
         // extra: the same filter with u = 0 (a random walk), Q from per-step displacements
         let q_rw = covariance(
-            &(1..rows.len()).filter(|i| in_train[*i] && !starts[*i]).map(|i| ext[i] - ext[i - 1]).collect::<Vec<_>>(),
+            &(1..rows.len())
+                .filter(|i| in_train[*i] && !starts[*i])
+                .map(|i| ext[i] - ext[i - 1])
+                .collect::<Vec<_>>(),
         );
         let est_rw = kalman_track(&z, &starts, q_rw, r, false);
         let rw_err: Vec<f64> = test.iter().map(|i| (est_rw[*i] - ext[*i]).norm()).collect();
         let app_err: Vec<f64> = test.iter().map(|i| (z[*i] - ext[*i]).norm()).collect();
         let kf_err: Vec<f64> = test.iter().map(|i| (est[*i] - ext[*i]).norm()).collect();
         let tt = stats::student_t(&kf_err, &app_err, DEFAULT_LEVEL)?;
-        let ((am, asd), (km, ksd), (rm, rsd)) = (mean_std(&app_err), mean_std(&kf_err), mean_std(&rw_err));
+        let ((am, asd), (km, ksd), (rm, rsd)) =
+            (mean_std(&app_err), mean_std(&kf_err), mean_std(&rw_err));
         let tt_rw = stats::student_t(&rw_err, &app_err, DEFAULT_LEVEL)?;
         out.tables.push(
             Table::new(
@@ -966,9 +1315,18 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             .with_precision("ours_col2", 4)
             .with_note("Q from deviations of the measured path from constant velocity, R from appearance-model position errors, both on training frames (m²)."),
         );
-        out.summary.push(format!("Kalman: {} → {} m, p = {:.4} (paper 0.154 → 0.145, significant).", fmt_ms(am, asd), fmt_ms(km, ksd), tt.p_two_sided));
+        out.summary.push(format!(
+            "Kalman: {} → {} m, p = {:.4} (paper 0.154 → 0.145, significant).",
+            fmt_ms(am, asd),
+            fmt_ms(km, ksd),
+            tt.p_two_sided
+        ));
         // fig 6: a fragment of the tracked path (first 60 consecutive frames of session 0)
-        let frag: Vec<usize> = (0..rows.len()).filter(|i| rows[*i].session == 0).skip(rows.len() / 4).take(60).collect();
+        let frag: Vec<usize> = (0..rows.len())
+            .filter(|i| rows[*i].session == 0)
+            .skip(rows.len() / 4)
+            .take(60)
+            .collect();
         let pts = |v: &[Vector2<f64>]| frag.iter().map(|i| (v[*i].x, v[*i].y)).collect::<Vec<_>>();
         let mut traj = vec![
             Series::line("measurement system", pts(&ext), 0),
@@ -985,14 +1343,33 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             FigureKind::TopView(TopView {
                 outline: Vec::new(),
                 obstacles: Vec::new(),
-                sensors: vec![Sensor { x: cam_xy.0, y: cam_xy.1, heading: Some(cam_yaw), label: "omnicam".into() }],
+                sensors: vec![Sensor {
+                    x: cam_xy.0,
+                    y: cam_xy.1,
+                    heading: Some(cam_yaw),
+                    label: "omnicam".into(),
+                }],
                 trajectories: traj,
                 circles: Vec::<Circle>::new(),
             }),
         ));
         if !rows.iter().all(|r| r.truth.is_none()) {
-            let app_truth: Vec<f64> = test.iter().filter_map(|i| rows[*i].truth.map(|(x, y)| (z[*i] - Vector2::new(x, y)).norm())).collect();
-            let kf_truth: Vec<f64> = test.iter().filter_map(|i| rows[*i].truth.map(|(x, y)| (est[*i] - Vector2::new(x, y)).norm())).collect();
+            let app_truth: Vec<f64> = test
+                .iter()
+                .filter_map(|i| {
+                    rows[*i]
+                        .truth
+                        .map(|(x, y)| (z[*i] - Vector2::new(x, y)).norm())
+                })
+                .collect();
+            let kf_truth: Vec<f64> = test
+                .iter()
+                .filter_map(|i| {
+                    rows[*i]
+                        .truth
+                        .map(|(x, y)| (est[*i] - Vector2::new(x, y)).norm())
+                })
+                .collect();
             let ((a1, a2), (k1, k2)) = (mean_std(&app_truth), mean_std(&kf_truth));
             out.tables.push(
                 Table::new(
@@ -1010,8 +1387,11 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     }
 
     // the general model on all data (or the loaded one): per-frame estimates, and the artefact
-    let general = loaded.as_ref().map_or_else(|| fit(&all, 400, spec), |m| m.regressor.clone());
-    out.artifacts.push(("estimates.csv".into(), estimates_csv(ctx, &omni, &general)?));
+    let general = loaded
+        .as_ref()
+        .map_or_else(|| fit(&all, 400, spec), |m| m.regressor.clone());
+    out.artifacts
+        .push(("estimates.csv".into(), estimates_csv(ctx, &omni, &general)?));
     if loaded.is_none() && !p.save_model.is_empty() {
         let model = AppearanceModel {
             kind: "omni_appearance".into(),
@@ -1020,12 +1400,23 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             regressor: general,
             train: spec,
             samples: rows.len(),
-            sessions: ctx.sessions.iter().map(|(s, _)| s.path.display().to_string()).collect(),
+            sessions: ctx
+                .sessions
+                .iter()
+                .map(|(s, _)| s.path.display().to_string())
+                .collect(),
             tool_version: ctx.provenance.tool_version.clone(),
             git_commit: ctx.provenance.git_commit.clone(),
         };
-        out.artifacts.push((p.save_model.clone().into(), serde_json::to_vec_pretty(&model)?));
-        out.summary.push(format!("General model trained on all {} frames saved to out/omni_appearance/{}.", rows.len(), p.save_model));
+        out.artifacts.push((
+            p.save_model.clone().into(),
+            serde_json::to_vec_pretty(&model)?,
+        ));
+        out.summary.push(format!(
+            "General model trained on all {} frames saved to out/omni_appearance/{}.",
+            rows.len(),
+            p.save_model
+        ));
     }
     Ok(out)
 }

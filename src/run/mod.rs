@@ -468,8 +468,13 @@ pub fn run_experiment<E: Experiment>(
             .push((f.title.clone(), format!("{name}/figures/{}.png", f.name)));
     }
     for (path, bytes) in &products.artifacts {
-        let path = if path.is_absolute() { path.clone() } else { pipeline_dir.join(path) };
-        atomic::write_atomic(&path, bytes, Some(&opts.out)).with_context(|| format!("writing {}", path.display()))?;
+        let path = if path.is_absolute() {
+            path.clone()
+        } else {
+            pipeline_dir.join(path)
+        };
+        atomic::write_atomic(&path, bytes, Some(&opts.out))
+            .with_context(|| format!("writing {}", path.display()))?;
         summary.artifacts.push(path.display().to_string());
     }
     summary.summary = products.summary;

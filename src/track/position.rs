@@ -28,7 +28,9 @@ impl PositionKf {
 
     /// Eq. 7–9. A singular innovation covariance leaves the state unchanged.
     pub fn correct(&mut self, z: Vector2<f64>) {
-        let Some(s_inv) = (self.p + self.r).try_inverse() else { return };
+        let Some(s_inv) = (self.p + self.r).try_inverse() else {
+            return;
+        };
         let k = self.p * s_inv;
         self.x += k * (z - self.x);
         self.p = (Matrix2::identity() - k) * self.p;
@@ -42,7 +44,10 @@ pub fn covariance(v: &[Vector2<f64>]) -> Matrix2<f64> {
     }
     let n = v.len() as f64;
     let mean = v.iter().sum::<Vector2<f64>>() / n;
-    v.iter().map(|d| (d - mean) * (d - mean).transpose()).sum::<Matrix2<f64>>() / (n - 1.0)
+    v.iter()
+        .map(|d| (d - mean) * (d - mean).transpose())
+        .sum::<Matrix2<f64>>()
+        / (n - 1.0)
 }
 
 #[cfg(test)]
@@ -55,7 +60,12 @@ mod tests {
     #[test]
     fn static_case_equals_its_closed_form() {
         let (r, p0) = (0.04, 1e3);
-        let mut kf = PositionKf { x: Vector2::new(0.5, -0.5), p: Matrix2::identity() * p0, q: Matrix2::zeros(), r: Matrix2::identity() * r };
+        let mut kf = PositionKf {
+            x: Vector2::new(0.5, -0.5),
+            p: Matrix2::identity() * p0,
+            q: Matrix2::zeros(),
+            r: Matrix2::identity() * r,
+        };
         let zs = [1.0, 1.4, 0.8, 1.2, 0.9, 1.05];
         for (i, z) in zs.iter().enumerate() {
             kf.predict(Vector2::zeros());
@@ -63,7 +73,11 @@ mod tests {
             let n = (i + 1) as f64;
             let pn = 1.0 / (1.0 / p0 + n / r);
             let xn = pn * (0.5 / p0 + zs[..=i].iter().sum::<f64>() / r);
-            assert!((kf.p[(0, 0)] - pn).abs() < 1e-12 && (kf.x.x - xn).abs() < 1e-12 && (kf.x.y + xn).abs() < 1e-12);
+            assert!(
+                (kf.p[(0, 0)] - pn).abs() < 1e-12
+                    && (kf.x.x - xn).abs() < 1e-12
+                    && (kf.x.y + xn).abs() < 1e-12
+            );
             let mean = zs[..=i].iter().sum::<f64>() / n;
             assert!((kf.x.x - mean).abs() < 1e-4, "close to the running mean");
         }
@@ -74,12 +88,20 @@ mod tests {
     #[test]
     fn random_walk_reaches_the_closed_form_steady_state() {
         let (q, r) = (0.024, 0.011);
-        let mut kf = PositionKf::new(Vector2::zeros(), Matrix2::identity() * q, Matrix2::identity() * r);
+        let mut kf = PositionKf::new(
+            Vector2::zeros(),
+            Matrix2::identity() * q,
+            Matrix2::identity() * r,
+        );
         for _ in 0..200 {
             kf.predict(Vector2::zeros());
             kf.correct(Vector2::zeros());
         }
         let steady = (-q + (q * q + 4.0 * q * r).sqrt()) / 2.0;
-        assert!((kf.p[(0, 0)] - steady).abs() < 1e-12, "{} vs {steady}", kf.p[(0, 0)]);
+        assert!(
+            (kf.p[(0, 0)] - steady).abs() < 1e-12,
+            "{} vs {steady}",
+            kf.p[(0, 0)]
+        );
     }
 }

@@ -27,7 +27,14 @@ pub struct Unwrapper {
 impl Unwrapper {
     /// Columns sweep the image angle `θ = 2π (col + ½) / width` (the angle of `atan2(v − yc,
     /// u − xc)`); rows sweep radius from `r_outer` (top) to `r_inner` (bottom).
-    pub fn new(xc: f64, yc: f64, r_inner: f64, r_outer: f64, width: usize, height: usize) -> Unwrapper {
+    pub fn new(
+        xc: f64,
+        yc: f64,
+        r_inner: f64,
+        r_outer: f64,
+        width: usize,
+        height: usize,
+    ) -> Unwrapper {
         let mut map = Vec::with_capacity(width * height);
         for row in 0..height {
             let r = r_outer - (r_outer - r_inner) * (row as f64 + 0.5) / height as f64;
@@ -95,13 +102,20 @@ impl Background {
     /// Learn from person-free panoramas: the mean, and thresholds from how those frames differ
     /// from it (pixel: 4σ of the differences, at least 10 grey levels; column and row: the
     /// largest count any background frame produced, plus 2).
-    pub fn learn(frames: &[Vec<f32>], width: usize, height: usize) -> Result<Background, OmniError> {
+    pub fn learn(
+        frames: &[Vec<f32>],
+        width: usize,
+        height: usize,
+    ) -> Result<Background, OmniError> {
         if frames.len() < 2 {
             return Err(OmniError::TooFewFrames(frames.len()));
         }
         let n = width * height;
         if let Some(f) = frames.iter().find(|f| f.len() != n) {
-            return Err(OmniError::Size { got: f.len(), want: n });
+            return Err(OmniError::Size {
+                got: f.len(),
+                want: n,
+            });
         }
         let mut mean = vec![0.0f32; n];
         for f in frames {
@@ -138,7 +152,10 @@ impl Background {
 
     /// Foreground mask of a panorama.
     pub fn foreground(&self, pano: &[f32]) -> Vec<bool> {
-        pano.iter().zip(&self.mean).map(|(v, m)| (v - m).abs() > self.pixel_threshold).collect()
+        pano.iter()
+            .zip(&self.mean)
+            .map(|(v, m)| (v - m).abs() > self.pixel_threshold)
+            .collect()
     }
 
     /// Column counts, and row counts within `cols` (a set of columns) or over all columns.
@@ -176,7 +193,10 @@ pub struct Features {
 /// Localise the person and compute the features; `None` when no column passes the threshold.
 pub fn features(bg: &Background, pano: &[f32]) -> Result<Option<Features>, OmniError> {
     if pano.len() != bg.mean.len() {
-        return Err(OmniError::Size { got: pano.len(), want: bg.mean.len() });
+        return Err(OmniError::Size {
+            got: pano.len(),
+            want: bg.mean.len(),
+        });
     }
     let fg = bg.foreground(pano);
     let (cols, _) = bg.histograms(&fg, None);
@@ -226,7 +246,12 @@ pub fn features(bg: &Background, pano: &[f32]) -> Result<Option<Features>, OmniE
     let (_, rows) = bg.histograms(&fg, Some(&member));
     let lower = (0..bg.height).rev().find(|&r| rows[r] > bg.row_threshold);
     let Some(lower) = lower else { return Ok(None) };
-    let pixels: f32 = member.iter().zip(&cols).filter(|(m, _)| **m).map(|(_, c)| c).sum();
+    let pixels: f32 = member
+        .iter()
+        .zip(&cols)
+        .filter(|(m, _)| **m)
+        .map(|(_, c)| c)
+        .sum();
     Ok(Some(Features {
         width: len as f64,
         apparent_distance: (bg.height - 1 - lower) as f64,
@@ -248,9 +273,18 @@ mod tests {
         let mut img = RgbImage::new(101, 101);
         let th = std::f64::consts::TAU * 0.5 / 36.0;
         let (x, y) = (50.5 + 30.5 * th.cos(), 50.5 + 30.5 * th.sin());
-        img.put_pixel(x.floor() as u32, y.floor() as u32, image::Rgb([255, 255, 255]));
+        img.put_pixel(
+            x.floor() as u32,
+            y.floor() as u32,
+            image::Rgb([255, 255, 255]),
+        );
         let pano = u.unwrap_grey(&img);
-        let best = pano.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1)).map(|(i, _)| i).expect("pixels");
+        let best = pano
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(i, _)| i)
+            .expect("pixels");
         assert_eq!((best % 36, best / 36), (0, 9));
         assert!((u.angle(0.0) - th).abs() < 1e-12);
     }
@@ -259,7 +293,9 @@ mod tests {
     fn a_block_in_the_panorama_gives_its_width_position_and_pixels() {
         let (w, h) = (48, 20);
         let base: Vec<f32> = (0..w * h).map(|i| 100.0 + (i % 7) as f32).collect();
-        let frames: Vec<Vec<f32>> = (0..5).map(|k| base.iter().map(|v| v + (k as f32 - 2.0)).collect()).collect();
+        let frames: Vec<Vec<f32>> = (0..5)
+            .map(|k| base.iter().map(|v| v + (k as f32 - 2.0)).collect())
+            .collect();
         let bg = Background::learn(&frames, w, h).expect("learns");
         // a person: columns 46..=49 (wrapping to 0, 1), rows 6..=15 → lower limit row 15
         let mut pano = base.clone();
