@@ -17,6 +17,7 @@ help:
 	@echo "make bench-mot tracking metrics: criterion on a synthetic sequence + py-motmetrics on the same files, with the ratio"
 	@echo "make interop   check that Python mcap-ros2-support opens what we write, synthetic datasets included (throwaway venv)"
 	@echo "make opencv-agreement  pixel agreement of vision::gmm masks with OpenCV MOG2 (throwaway venv)"
+	@echo "make bench-mlp         appearance-model training (10 splits) beside scikit-learn MLPRegressor, with the ratio"
 	@echo "make bench-gmm         adaptive GMM frames/s beside OpenCV MOG2 on the same frames, with ratios"
 	@echo "make clean     remove build outputs and out/"
 
@@ -51,11 +52,21 @@ bench: $(VENV)/ok
 	$(VENV)/bin/python tools/bench_compare.py target/criterion target/bench-data/python_read.json
 	$(MAKE) bench-mot
 	$(MAKE) bench-gmm
+	$(MAKE) bench-mlp
 
 # py-motmetrics 1.4.0 calls np.asfarray, which numpy 2 removed: pin the last numpy 1 stack.
 $(VENV_MOT)/mot-ok:
 	$(PYTHON) -m venv $(VENV_MOT)
 	$(VENV_MOT)/bin/pip install --quiet --disable-pip-version-check motmetrics==1.4.0 numpy==1.26.4 pandas==2.2.3 scipy==1.13.1
+	touch $@
+
+.PHONY: bench-mlp
+bench-mlp: $(VENV)/sklearn-ok
+	$(CARGO) bench --bench mlp -- --noplot
+	$(VENV)/bin/python tools/bench_sklearn_mlp.py target/bench-data/mlp target/criterion
+
+$(VENV)/sklearn-ok: $(VENV)/ok
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check scikit-learn==1.7.2 numpy==2.2.6
 	touch $@
 
 .PHONY: bench-mot
