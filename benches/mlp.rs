@@ -16,7 +16,11 @@ use serde_json::json;
 
 const FRAMES: usize = 684;
 const SPLITS: usize = 10;
-const SPEC: TrainSpec = TrainSpec { hidden: 4, learning_rate: 0.3, epochs: 200 };
+const SPEC: TrainSpec = TrainSpec {
+    hidden: 4,
+    learning_rate: 0.3,
+    epochs: 200,
+};
 
 /// Features shaped like the omni cues: width and pixels fall with distance, the apparent
 /// distance grows with it; all with noise.
@@ -26,7 +30,11 @@ fn data() -> (Vec<Vec<f64>>, Vec<f64>) {
     let (mut xs, mut ys) = (Vec::new(), Vec::new());
     for k in 0..FRAMES {
         let d = 0.8 + 4.0 * (k as f64 * 0.618_034).fract();
-        xs.push(vec![60.0 / d + noise(3.0), 12.0 * d + noise(4.0), 3000.0 / (d * d) + noise(80.0)]);
+        xs.push(vec![
+            60.0 / d + noise(3.0),
+            12.0 * d + noise(4.0),
+            3000.0 / (d * d) + noise(80.0),
+        ]);
         ys.push(d);
     }
     (xs, ys)
@@ -51,7 +59,10 @@ fn train(xs: &[Vec<f64>], ys: &[f64], split: &[usize], s: usize) -> Regressor {
 
 fn test_error(xs: &[Vec<f64>], ys: &[f64], split: &[usize], m: &Regressor) -> f64 {
     let test: Vec<usize> = (0..FRAMES).filter(|i| !split.contains(i)).collect();
-    test.iter().map(|i| (m.predict(&xs[*i]) - ys[*i]).abs()).sum::<f64>() / test.len() as f64
+    test.iter()
+        .map(|i| (m.predict(&xs[*i]) - ys[*i]).abs())
+        .sum::<f64>()
+        / test.len() as f64
 }
 
 fn bench(c: &mut Criterion) {
@@ -64,7 +75,11 @@ fn bench(c: &mut Criterion) {
         csv.push_str(&format!("{},{},{},{}\n", x[0], x[1], x[2], y));
     }
     std::fs::write(dir.join("data.csv"), csv).expect("write data");
-    let errors: Vec<f64> = sp.iter().enumerate().map(|(s, split)| test_error(&xs, &ys, split, &train(&xs, &ys, split, s))).collect();
+    let errors: Vec<f64> = sp
+        .iter()
+        .enumerate()
+        .map(|(s, split)| test_error(&xs, &ys, split, &train(&xs, &ys, split, s)))
+        .collect();
     let meta = json!({
         "splits": sp,
         "hidden": SPEC.hidden,
@@ -72,15 +87,29 @@ fn bench(c: &mut Criterion) {
         "epochs": SPEC.epochs,
         "ours_test_mae_per_split": errors,
     });
-    std::fs::write(dir.join("protocol.json"), serde_json::to_vec_pretty(&meta).expect("json")).expect("write protocol");
+    std::fs::write(
+        dir.join("protocol.json"),
+        serde_json::to_vec_pretty(&meta).expect("json"),
+    )
+    .expect("write protocol");
 
     let mut g = c.benchmark_group("mlp");
     g.sample_size(10);
     g.bench_function("ten_splits_sequential", |b| {
-        b.iter(|| sp.iter().enumerate().map(|(s, split)| train(&xs, &ys, split, s)).collect::<Vec<_>>());
+        b.iter(|| {
+            sp.iter()
+                .enumerate()
+                .map(|(s, split)| train(&xs, &ys, split, s))
+                .collect::<Vec<_>>()
+        });
     });
     g.bench_function("ten_splits_rayon", |b| {
-        b.iter(|| sp.par_iter().enumerate().map(|(s, split)| train(&xs, &ys, split, s)).collect::<Vec<_>>());
+        b.iter(|| {
+            sp.par_iter()
+                .enumerate()
+                .map(|(s, split)| train(&xs, &ys, split, s))
+                .collect::<Vec<_>>()
+        });
     });
     g.finish();
 }
