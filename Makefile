@@ -28,7 +28,7 @@ datasets: release
 	./target/release/peopletrack synth --if-absent --profile $(PROFILE) datasets/*/scenario.toml
 
 eval: datasets
-	./target/release/peopletrack eval
+	./target/release/peopletrack eval --profile $(PROFILE)
 
 test:
 	$(CARGO) test --locked

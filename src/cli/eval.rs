@@ -22,9 +22,41 @@ pub struct Args {
     /// Recompute sessions even when cached results match.
     #[arg(long)]
     pub force: bool,
-    /// Output root.
-    #[arg(long, default_value = "out")]
-    pub out: PathBuf,
+    /// Dataset profile: `quick` (the default datasets) or `full` (paper-sized logs that
+    /// `make datasets PROFILE=full` writes to `datasets/<name>/full/`; each pipeline's input
+    /// globs are redirected there and the default output root becomes `out/full`).
+    #[arg(long, default_value = "quick", value_parser = ["quick", "full"])]
+    pub profile: String,
+    /// Output root (default `out`, or `out/full` for the full profile).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// `datasets/x/*.mcap` -> `datasets/x/full/*.mcap`: the same glob one folder down.
+fn full_profile_glob(glob: &str) -> String {
+    let p = std::path::Path::new(glob);
+    match (p.parent(), p.file_name()) {
+        (Some(dir), Some(name)) => dir.join("full").join(name).display().to_string(),
+        _ => format!("full/{glob}"),
+    }
+}
+
+/// The `[inputs] sessions` globs of a pipeline file, redirected for the full profile.
+fn full_sessions(file: &std::path::Path) -> anyhow::Result<Vec<String>> {
+    let text =
+        std::fs::read_to_string(file).with_context(|| format!("reading {}", file.display()))?;
+    let v: toml::Value =
+        toml::from_str(&text).with_context(|| format!("{} is not TOML", file.display()))?;
+    let globs = v
+        .get("inputs")
+        .and_then(|i| i.get("sessions"))
+        .and_then(|s| s.as_array())
+        .map_or_else(Vec::new, |a| {
+            a.iter()
+                .filter_map(|g| g.as_str().map(full_profile_glob))
+                .collect()
+        });
+    Ok(globs)
 }
 
 pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
@@ -43,19 +75,30 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     if files.is_empty() {
         anyhow::bail!("no pipeline files in {}", a.pipelines.display());
     }
-    atomic::sweep_scratch(&a.out)?;
-    let opts = RunOptions {
+    let out_root = a.out.clone().unwrap_or_else(|| {
+        PathBuf::from(if a.profile == "full" {
+            "out/full"
+        } else {
+            "out"
+        })
+    });
+    atomic::sweep_scratch(&out_root)?;
+    let base = RunOptions {
         sessions: None,
         dry_run: false,
         shard: None,
         aggregate_only: false,
         force: a.force,
-        out: a.out.clone(),
+        out: out_root.clone(),
         git_commit: super::git_commit(),
         progress: super::stderr_is_terminal(),
     };
     let mut runs = Vec::new();
     for f in &files {
+        let mut opts = base.clone();
+        if a.profile == "full" {
+            opts.sessions = Some(full_sessions(f)?);
+        }
         let s =
             pipelines::run_file(f, &opts).with_context(|| format!("pipeline {}", f.display()))?;
         writeln!(
@@ -75,19 +118,33 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     }
     let mut tables = BTreeMap::new();
     for (_, path) in runs.iter().flat_map(|r| r.tables.iter()) {
-        let text =
-            std::fs::read_to_string(a.out.join(path)).with_context(|| format!("reading {path}"))?;
+        let text = std::fs::read_to_string(out_root.join(path))
+            .with_context(|| format!("reading {path}"))?;
         tables.insert(path.clone(), text);
     }
     let header = report::Header {
         tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        git_commit: opts.git_commit.clone(),
+        git_commit: base.git_commit.clone(),
         rustc: super::rustc_version(),
         total_seconds: started.elapsed().as_secs_f64(),
     };
     let md = report::render(&runs, &tables, &header);
-    let path = a.out.join("REPORT.md");
-    atomic::write_atomic(&path, md.as_bytes(), Some(&a.out))?;
+    let path = out_root.join("REPORT.md");
+    atomic::write_atomic(&path, md.as_bytes(), Some(&out_root))?;
     writeln!(out, "wrote {}", path.display())?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::full_profile_glob;
+
+    #[test]
+    fn full_profile_globs_go_one_folder_down() {
+        assert_eq!(
+            full_profile_glob("datasets/omni_lab/*.mcap"),
+            "datasets/omni_lab/full/*.mcap"
+        );
+        assert_eq!(full_profile_glob("*.mcap"), "full/*.mcap");
+    }
 }
