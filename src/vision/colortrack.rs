@@ -15,7 +15,8 @@
 //!   weights `ω_i = √(o_b / r_b)` of eq. 21, (3) `q_i ∝ ω_i N(x_i; θ⁽ᵏ⁾, V⁽ᵏ⁾)` (eq. 7),
 //!   (4) `θ⁽ᵏ⁺¹⁾ = Σ q_i x_i` (eq. 9), (5) `V⁽ᵏ⁺¹⁾ = β Σ q_i (x_i − θ⁽ᵏ⁾)(x_i − θ⁽ᵏ⁾)ᵀ`
 //!   (eq. 15, deviations from the *previous* centre, as printed) with β = [`DEFAULT_BETA`] = 1.1,
-//!   (6) stop when the new 2.5σ region includes no pixel the old one did not. Optionally V is
+//!   (6) stop when the new 2.5σ region holds the same pixels as the old one (no pixel enters
+//!   or leaves; see `pixel_set_changed` for why not "no pixel enters"). Optionally V is
 //!   kept diagonal ([`Shape::Diagonal`], the paper's setting for walking people).
 //! - **Mean shift** ([`mean_shift`]): the same weights with V fixed, `θ ← Σ ω_i g_i x_i / Σ ω_i g_i`
 //!   (eq. 9: with a Gaussian kernel the mean-shift step is the EM position step), until the
@@ -41,6 +42,20 @@ use super::view::ImageView;
 pub const DEFAULT_BETA: f64 = 1.1;
 /// Pixels further than this many σ from the centre are disregarded (section 5).
 pub const DEFAULT_CUTOFF_SIGMA: f64 = 2.5;
+/// The β for which eq. 15 leaves V unchanged when every weight is equal and the samples are
+/// cut off at `cutoff_sigma` by the 2-D elliptical region: the inverse of the per-axis second
+/// moment of a standard 2-D Gaussian truncated to `d² ≤ c²`,
+/// `1 / (1 − c² e^(−c²/2) / (2 (1 − e^(−c²/2))))` — 1.168 for c = 2.5.
+///
+/// The paper's β ≈ 1.1 is the same quantity for a *1-D* Gaussian cut at ±2.5σ (1.097). With a
+/// 2-D elliptical cut-off, β = 1.1 makes every iteration shrink V by 1.1 / 1.168 = 0.94 where the
+/// weights are flat, so the region settles smaller than the object (measured in the tests and
+/// reported by the `background_tracking` pipeline beside the paper's value).
+pub fn consistent_beta(cutoff_sigma: f64) -> f64 {
+    let c2 = cutoff_sigma * cutoff_sigma;
+    let tail = (-0.5 * c2).exp();
+    1.0 / (1.0 - c2 * tail / (2.0 * (1.0 - tail)))
+}
 /// Iteration cap per frame, for both trackers (the paper reports about 6 on average).
 pub const DEFAULT_MAX_ITERATIONS: u32 = 30;
 /// Mean shift stops when the centre moves less than this (pixels).
@@ -438,13 +453,24 @@ fn regularise(cov: Matrix2<f64>, shape: Shape, min_var: f64, max_var: f64) -> Ma
     Ellipse::from_axes(0.0, 0.0, c1.sqrt(), c2.sqrt(), ax.angle).cov
 }
 
-/// Does the `cutoff`σ region of `new` hold a pixel (of the frame) outside that of `old`?
-fn has_new_pixels(bins: &BinImage, old: &Ellipse, new: &Ellipse, cutoff: f64) -> bool {
+/// Do the `cutoff`σ regions of `old` and `new` hold different pixel sets (of the frame)?
+///
+/// Step 6 of section 5.2 stops "if no new pixels are included"; read literally, any step that
+/// only shrinks the region would stop the iterations (a region that starts too large could
+/// never shrink to the object's size in more than one step), so we stop when no pixel enters
+/// *and* none leaves: the region's pixel set, and hence every weight, is unchanged.
+fn pixel_set_changed(bins: &BinImage, old: &Ellipse, new: &Ellipse, cutoff: f64) -> bool {
     let (Some(inv_old), Some(inv_new)) = (old.precision(), new.precision()) else {
         return true;
     };
     let c2 = cutoff * cutoff;
-    let b = new.bbox(cutoff);
+    let (bo, bn) = (old.bbox(cutoff), new.bbox(cutoff));
+    let b = [
+        bo[0].min(bn[0]),
+        bo[1].min(bn[1]),
+        bo[2].max(bn[2]),
+        bo[3].max(bn[3]),
+    ];
     let (w, h) = (bins.width as f64, bins.height as f64);
     if !(b[2] >= 0.0 && b[3] >= 0.0 && b[0] < w && b[1] < h) {
         return false;
@@ -457,11 +483,11 @@ fn has_new_pixels(bins: &BinImage, old: &Ellipse, new: &Ellipse, cutoff: f64) ->
         for x in x0..=x1 {
             let p = Vector2::new(x as f64, y as f64);
             let dn = p - new.center.coords;
-            if dn.dot(&(inv_new * dn)) <= c2 {
-                let dold = p - old.center.coords;
-                if dold.dot(&(inv_old * dold)) > c2 {
-                    return true;
-                }
+            let dold = p - old.center.coords;
+            let in_new = dn.dot(&(inv_new * dn)) <= c2;
+            let in_old = dold.dot(&(inv_old * dold)) <= c2;
+            if in_new != in_old {
+                return true;
             }
         }
     }
@@ -527,9 +553,9 @@ pub fn em_like(
         let cov = Matrix2::new(sxx, sxy, sxy, syy) * (p.beta / total);
         let next = Ellipse::new(center, regularise(cov, p.shape, min_var, max_var));
         iterations += 1;
-        let grew = has_new_pixels(bins, &current, &next, p.cutoff_sigma);
+        let changed = pixel_set_changed(bins, &current, &next, p.cutoff_sigma);
         current = next;
-        if !grew {
+        if !changed {
             converged = true;
             break;
         }

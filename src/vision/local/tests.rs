@@ -76,7 +76,7 @@ fn one_near(obs: &[Observation], person: (i64, i64), tol: f64, what: &str) -> Ob
     assert_eq!(obs.len(), 1, "{what}: {obs:?}");
     let o = obs[0].clone();
     let d = (o.region.center - centre(person)).norm();
-    assert!(d < tol, "{what}: {d:.1} px from the person ({:?})", o.mode);
+    assert!(d < tol, "{what}: {d:.1} px from the person ({:?}): {:?} vs {:?}", o.mode, o, centre(person));
     o
 }
 
@@ -89,10 +89,11 @@ fn walking_standing_and_walking_again_keeps_one_track() {
         assert!(step(&mut t, &frame(k, 0, None), false).is_empty());
         k += 1;
     }
-    // walk right 1 px per frame
+    // walk right 3 px per frame (a uniform-colour body moving slower is absorbed from behind:
+    // at α = 1/60 a pixel covered for 6 frames joins the background)
     let mut id = None;
     let mut x = 10;
-    for _ in 0..30 {
+    for _ in 0..15 {
         let obs = step(&mut t, &frame(k, 0, Some((x, 30))), false);
         let o = one_near(&obs, (x, 30), 2.0, "walking");
         assert_eq!(o.mode, Mode::Blob);
@@ -101,7 +102,7 @@ fn walking_standing_and_walking_again_keeps_one_track() {
         for &l in &o.blobs {
             assert!(t.labels().contains(&l));
         }
-        x += 1;
+        x += 3;
         k += 1;
     }
     // stand still long enough for the background to absorb the person
@@ -123,8 +124,8 @@ fn walking_standing_and_walking_again_keeps_one_track() {
     assert!(absorbed < (PW * PH / 4) as usize, "person still in the mask: {absorbed} px");
     // walk on: the blob takes the track back (the ghost left behind does not)
     let mut back = false;
-    for _ in 0..25 {
-        x += 2;
+    for _ in 0..10 {
+        x += 3;
         let obs = step(&mut t, &frame(k, 0, Some((x, 30))), false);
         k += 1;
         let mine: Vec<_> = obs.iter().filter(|o| Some(o.track) == id).collect();
@@ -151,7 +152,7 @@ fn camera_motion_hands_over_to_the_colour_tracker_and_back() {
     for _ in 0..15 {
         let obs = step(&mut t, &frame(k, 0, Some((x, 30))), false);
         id = Some(one_near(&obs, (x, 30), 2.0, "before panning").track);
-        x += 1;
+        x += 3;
         k += 1;
     }
     // the camera pans 1 px per frame: the person moves 1 px left in the image
