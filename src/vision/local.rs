@@ -48,7 +48,8 @@ use serde::{Deserialize, Serialize};
 
 use super::blobs::{self, Blob, BlobError, Connectivity, Moments};
 use super::colortrack::{
-    BinImage, ColorSpace, ColorTrackError, EmParams, Histogram, Shape, em_like, kernel_histogram,
+    BinImage, ColorSpace, ColorTrackError, DEFAULT_CUTOFF_SIGMA, EmParams, Histogram, Shape,
+    consistent_beta, em_like, kernel_histogram,
 };
 use super::ellipse::{Ellipse, SHAPE_SIGMA};
 use super::gmm::{AdaptiveGmm, FOREGROUND, GmmError, GmmParams};
@@ -132,8 +133,11 @@ impl Default for LocalParams {
             min_travel_px: 10.0,
             warmup_frames: 30,
             color: ColorSpace::Hs,
+            // β consistent with the 2-D cut-off: the paper's 1.1 shrinks the region every
+            // frame (see `colortrack::consistent_beta`), which a long hand-over cannot afford
             em: EmParams {
                 shape: Shape::Diagonal,
+                beta: consistent_beta(DEFAULT_CUTOFF_SIGMA),
                 ..EmParams::default()
             },
             min_similarity: 0.6,
@@ -450,6 +454,7 @@ impl LocalTracker {
         let gate2 = p.gate_sigma * p.gate_sigma;
         let ellipses: Vec<Ellipse> = self.blobs.iter().map(Blob::ellipse).collect();
         let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+        let mut held = vec![false; self.blobs.len()];
         for (ti, t) in self.tracks.iter().enumerate() {
             if t.ended {
                 continue;
@@ -462,12 +467,15 @@ impl LocalTracker {
                     continue;
                 }
                 if let Mode::Colour(why) = t.mode {
-                    if e.overlap(&t.region) < p.reacquire_overlap {
-                        continue;
-                    }
                     if why == HandOver::StandingStill
                         && t.anchor.is_some_and(|a| (e.center - a).norm() < p.resume_px)
                     {
+                        // the still person's own (fading) blob: it neither takes the track
+                        // back nor starts a new one
+                        held[bi] = true;
+                        continue;
+                    }
+                    if e.overlap(&t.region) < p.reacquire_overlap {
                         continue;
                     }
                 }
@@ -491,7 +499,7 @@ impl LocalTracker {
         // fragments: unmatched blobs inside the 2σ ellipse of a matched track's blob
         let sigma2 = SHAPE_SIGMA * SHAPE_SIGMA;
         for bi in 0..self.blobs.len() {
-            if blob_owner[bi].is_some() {
+            if blob_owner[bi].is_some() || held[bi] {
                 continue;
             }
             let host = (0..self.tracks.len()).find(|&ti| {
@@ -577,7 +585,7 @@ impl LocalTracker {
         }
         // new tracks from the remaining blobs, in label order
         for (bi, b) in self.blobs.iter().enumerate() {
-            if blob_owner[bi].is_some() {
+            if blob_owner[bi].is_some() || held[bi] {
                 continue;
             }
             let region = ellipses[bi];
