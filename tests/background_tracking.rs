@@ -200,10 +200,13 @@ fn pipeline_end_to_end_on_a_tiny_scene() {
         for w in pts.windows(2) {
             assert!(w[1].1 <= w[0].1 && w[1].2 <= w[0].2, "{m}: {pts:?}");
         }
-        assert!(pts[0].1 > 30.0, "{m}: the walker is mostly detected: {pts:?}");
+        assert!(
+            pts[0].1 > 30.0,
+            "{m}: the walker is mostly detected: {pts:?}"
+        );
     }
 
-    // colour trackers: four rows (HS/RGB x EM-like/mean shift), EM-like close to the walker
+    // colour trackers: four rows (HS/RGB x EM-like/mean shift)
     let ct = csv(&a, "colour_trackers");
     assert_eq!(ct.len(), 5, "{ct:?}");
     let h = &ct[0];

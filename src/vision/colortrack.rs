@@ -73,7 +73,9 @@ pub const BINS_PER_CHANNEL: usize = 8;
 pub enum ColorTrackError {
     #[error("colour tracking needs a 3-channel RGB frame, not {channels} channel(s)")]
     Channels { channels: usize },
-    #[error("frame is {width}x{height} ({space:?}) but the tracker holds {have_width}x{have_height} ({have_space:?})")]
+    #[error(
+        "frame is {width}x{height} ({space:?}) but the tracker holds {have_width}x{have_height} ({have_space:?})"
+    )]
     FrameMismatch {
         width: usize,
         height: usize,
@@ -362,7 +364,11 @@ impl EmParams {
             return Err(bad("beta", self.beta, "must be finite and positive"));
         }
         if !(self.cutoff_sigma.is_finite() && self.cutoff_sigma > 0.0) {
-            return Err(bad("cutoff_sigma", self.cutoff_sigma, "must be finite and positive"));
+            return Err(bad(
+                "cutoff_sigma",
+                self.cutoff_sigma,
+                "must be finite and positive",
+            ));
         }
         if self.max_iterations == 0 {
             return Err(bad("max_iterations", 0.0, "must be at least 1"));
@@ -374,13 +380,21 @@ impl EmParams {
 impl MeanShiftParams {
     pub fn validate(&self) -> Result<(), ColorTrackError> {
         if !(self.cutoff_sigma.is_finite() && self.cutoff_sigma > 0.0) {
-            return Err(bad("cutoff_sigma", self.cutoff_sigma, "must be finite and positive"));
+            return Err(bad(
+                "cutoff_sigma",
+                self.cutoff_sigma,
+                "must be finite and positive",
+            ));
         }
         if self.max_iterations == 0 {
             return Err(bad("max_iterations", 0.0, "must be at least 1"));
         }
         if !(self.epsilon_px.is_finite() && self.epsilon_px > 0.0) {
-            return Err(bad("epsilon_px", self.epsilon_px, "must be finite and positive"));
+            return Err(bad(
+                "epsilon_px",
+                self.epsilon_px,
+                "must be finite and positive",
+            ));
         }
         if !(0.0..1.0).contains(&self.scale_step) {
             return Err(bad("scale_step", self.scale_step, "must be in [0, 1)"));
@@ -426,7 +440,10 @@ impl TrackResult {
 fn weights(model: &Histogram, region_hist: &Histogram, s: &[Sample], out: &mut Vec<f64>) {
     out.clear();
     out.extend(s.iter().map(|p| {
-        let (o, r) = (model.values[p.bin as usize], region_hist.values[p.bin as usize]);
+        let (o, r) = (
+            model.values[p.bin as usize],
+            region_hist.values[p.bin as usize],
+        );
         if r > 0.0 { (o / r).sqrt() } else { 0.0 }
     }));
 }
@@ -560,8 +577,8 @@ pub fn em_like(
             break;
         }
     }
-    let similarity = kernel_histogram(bins, &current, p.cutoff_sigma)
-        .map_or(0.0, |h| bhattacharyya(&h, model));
+    let similarity =
+        kernel_histogram(bins, &current, p.cutoff_sigma).map_or(0.0, |h| bhattacharyya(&h, model));
     Ok(TrackResult {
         region: current,
         iterations,
@@ -610,8 +627,8 @@ pub fn mean_shift(
             break;
         }
     }
-    let similarity = kernel_histogram(bins, &current, p.cutoff_sigma)
-        .map_or(0.0, |h| bhattacharyya(&h, model));
+    let similarity =
+        kernel_histogram(bins, &current, p.cutoff_sigma).map_or(0.0, |h| bhattacharyya(&h, model));
     Ok(TrackResult {
         region: current,
         iterations,
@@ -644,7 +661,10 @@ pub fn mean_shift_scaled(
         if r.lost {
             continue;
         }
-        if best.as_ref().is_none_or(|(_, b)| r.similarity > b.similarity) {
+        if best
+            .as_ref()
+            .is_none_or(|(_, b)| r.similarity > b.similarity)
+        {
             best = Some((scale, r));
         }
     }
@@ -653,8 +673,8 @@ pub fn mean_shift_scaled(
     };
     let f = p.scale_gamma * scale + (1.0 - p.scale_gamma);
     let region = Ellipse::new(r.region.center, start.scaled(f).cov);
-    let similarity = kernel_histogram(bins, &region, p.cutoff_sigma)
-        .map_or(0.0, |h| bhattacharyya(&h, model));
+    let similarity =
+        kernel_histogram(bins, &region, p.cutoff_sigma).map_or(0.0, |h| bhattacharyya(&h, model));
     Ok(TrackResult {
         region,
         iterations: r.iterations,
@@ -724,8 +744,7 @@ impl ColorTracker {
 
     /// Track into the next frame; the region is updated unless the object is lost.
     pub fn track(&mut self, frame: &BinImage) -> Result<TrackResult, ColorTrackError> {
-        if (frame.width, frame.height, frame.space) != (self.width, self.height, self.model.space)
-        {
+        if (frame.width, frame.height, frame.space) != (self.width, self.height, self.model.space) {
             return Err(ColorTrackError::FrameMismatch {
                 width: frame.width,
                 height: frame.height,

@@ -50,7 +50,12 @@ impl Ellipse {
     pub fn from_axes(cx: f64, cy: f64, major_sigma: f64, minor_sigma: f64, angle: f64) -> Self {
         let (c, s) = (angle.cos(), angle.sin());
         let r = Matrix2::new(c, -s, s, c);
-        let d = Matrix2::new(major_sigma * major_sigma, 0.0, 0.0, minor_sigma * minor_sigma);
+        let d = Matrix2::new(
+            major_sigma * major_sigma,
+            0.0,
+            0.0,
+            minor_sigma * minor_sigma,
+        );
         let cov = r * d * r.transpose();
         // exact symmetry whatever the rounding
         let off = 0.5 * (cov[(0, 1)] + cov[(1, 0)]);
@@ -184,7 +189,10 @@ mod tests {
             assert!(close(ax.minor_sigma, 3.0, 1e-9), "{ax:?}");
             // angles are defined modulo π
             let d = (ax.angle - angle).rem_euclid(std::f64::consts::PI);
-            assert!(d < 1e-9 || (std::f64::consts::PI - d) < 1e-9, "{angle} {ax:?}");
+            assert!(
+                d < 1e-9 || (std::f64::consts::PI - d) < 1e-9,
+                "{angle} {ax:?}"
+            );
             assert!(e.is_valid());
         }
     }
@@ -208,7 +216,11 @@ mod tests {
         // a 2σ region of radius 20 inside one of radius 40: IoU = 1/4
         let small = Ellipse::from_parts(0.0, 0.0, 100.0, 0.0, 100.0);
         let big = small.scaled(2.0);
-        assert!(close(small.overlap(&big), 0.25, 0.01), "{}", small.overlap(&big));
+        assert!(
+            close(small.overlap(&big), 0.25, 0.01),
+            "{}",
+            small.overlap(&big)
+        );
         let far = Ellipse::from_parts(500.0, 0.0, 100.0, 0.0, 100.0);
         assert_eq!(small.overlap(&far), 0.0);
     }

@@ -468,7 +468,8 @@ impl LocalTracker {
                 }
                 if let Mode::Colour(why) = t.mode {
                     if why == HandOver::StandingStill
-                        && t.anchor.is_some_and(|a| (e.center - a).norm() < p.resume_px)
+                        && t.anchor
+                            .is_some_and(|a| (e.center - a).norm() < p.resume_px)
                     {
                         // the still person's own (fading) blob: it neither takes the track
                         // back nor starts a new one
@@ -535,7 +536,12 @@ impl LocalTracker {
                 t.anchor = None;
             }
             let mut m = Moments::default();
-            let mut bbox = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+            let mut bbox = [
+                f64::INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::NEG_INFINITY,
+            ];
             let mut labels = Vec::with_capacity(mine.len());
             for &bi in mine {
                 let b = &self.blobs[bi];

@@ -25,7 +25,12 @@ fn noise(x: usize, y: usize, k: u64) -> i32 {
 /// of green, grey and blue. Returns the RGB bytes and the object mask (255 on the object).
 fn frame(center: (f64, f64), a: Matrix2<f64>, seed: u64) -> (Vec<u8>, Vec<u8>) {
     let inv = a.try_inverse().expect("invertible");
-    let palette = [[60, 130, 60], [128, 128, 128], [70, 90, 160], [150, 160, 120]];
+    let palette = [
+        [60, 130, 60],
+        [128, 128, 128],
+        [70, 90, 160],
+        [150, 160, 120],
+    ];
     let (mut rgb, mut mask) = (vec![0u8; W * H * 3], vec![0u8; W * H]);
     for y in 0..H {
         for x in 0..W {
@@ -33,12 +38,17 @@ fn frame(center: (f64, f64), a: Matrix2<f64>, seed: u64) -> (Vec<u8>, Vec<u8>) {
             let inside = (p.x / 24.0).powi(2) + (p.y / 40.0).powi(2) <= 1.0;
             let base = if inside {
                 mask[y * W + x] = 255;
-                if p.y < 0.0 { [200, 30, 40] } else { [230, 200, 40] }
+                if p.y < 0.0 {
+                    [200, 30, 40]
+                } else {
+                    [230, 200, 40]
+                }
             } else {
                 palette[(mix(((y / 5) * 1000 + x / 5) as u64 + seed) % 4) as usize]
             };
             for c in 0..3 {
-                rgb[(y * W + x) * 3 + c] = (base[c] + noise(x, y, seed * 3 + c as u64)).clamp(0, 255) as u8;
+                rgb[(y * W + x) * 3 + c] =
+                    (base[c] + noise(x, y, seed * 3 + c as u64)).clamp(0, 255) as u8;
             }
         }
     }
@@ -215,8 +225,8 @@ fn em_like_recovers_a_rotated_stretched_ellipse() {
 #[test]
 fn paper_beta_shrinks_the_region_with_a_2d_cutoff() {
     let c = case(ColorSpace::Hs);
-    let model = kernel_histogram(&c.model_frame, &c.model_region, DEFAULT_CUTOFF_SIGMA)
-        .expect("pixels");
+    let model =
+        kernel_histogram(&c.model_frame, &c.model_region, DEFAULT_CUTOFF_SIGMA).expect("pixels");
     let want = c.target_truth;
     let paper = em_like(&c.target, &model, &want, &EmParams::default()).expect("runs");
     let ours = EmParams {
@@ -246,11 +256,18 @@ fn papers_figure_2_case_em_like_overlaps_more_than_mean_shift() {
             ..EmParams::default()
         };
         let em = em_like(&c.target, &model, &c.start, &p).expect("runs");
-        let ms = mean_shift(&c.target, &model, &c.start, &MeanShiftParams::default())
-            .expect("runs");
+        let ms =
+            mean_shift(&c.target, &model, &c.start, &MeanShiftParams::default()).expect("runs");
         report(&format!("{space:?} fig. 2 EM-like"), &em, &c.target_truth);
-        report(&format!("{space:?} fig. 2 mean shift"), &ms, &c.target_truth);
-        assert!(angle_error_deg(&em.region, &c.target_truth) < angle_error_deg(&ms.region, &c.target_truth));
+        report(
+            &format!("{space:?} fig. 2 mean shift"),
+            &ms,
+            &c.target_truth,
+        );
+        assert!(
+            angle_error_deg(&em.region, &c.target_truth)
+                < angle_error_deg(&ms.region, &c.target_truth)
+        );
         assert!(em.region.overlap(&c.target_truth) > ms.region.overlap(&c.target_truth));
     }
 }
@@ -260,8 +277,8 @@ fn papers_figure_2_case_em_like_overlaps_more_than_mean_shift() {
 #[test]
 fn mean_shift_recovers_position_but_not_shape() {
     let c = case(ColorSpace::Hs);
-    let model = kernel_histogram(&c.model_frame, &c.model_region, DEFAULT_CUTOFF_SIGMA)
-        .expect("pixels");
+    let model =
+        kernel_histogram(&c.model_frame, &c.model_region, DEFAULT_CUTOFF_SIGMA).expect("pixels");
     let p = MeanShiftParams::default();
     let plain = mean_shift(&c.target, &model, &c.start, &p).expect("runs");
     let scaled = mean_shift_scaled(&c.target, &model, &c.start, &p).expect("runs");
@@ -287,8 +304,8 @@ fn mean_shift_recovers_position_but_not_shape() {
 #[test]
 fn diagonal_shape_stays_axis_aligned_and_lost_objects_do_not_move() {
     let c = case(ColorSpace::Hs);
-    let model = kernel_histogram(&c.model_frame, &c.model_region, DEFAULT_CUTOFF_SIGMA)
-        .expect("pixels");
+    let model =
+        kernel_histogram(&c.model_frame, &c.model_region, DEFAULT_CUTOFF_SIGMA).expect("pixels");
     let p = EmParams {
         shape: Shape::Diagonal,
         ..EmParams::default()
@@ -301,9 +318,15 @@ fn diagonal_shape_stays_axis_aligned_and_lost_objects_do_not_move() {
     // is lost and nothing moves
     let cyan: Vec<u8> = [0u8, 170, 255].repeat(W * H);
     let cyan = bins(&cyan, ColorSpace::Hs);
-    assert_eq!(model.values()[usize::from(ColorSpace::Hs.bin(0, 170, 255))], 0.0);
+    assert_eq!(
+        model.values()[usize::from(ColorSpace::Hs.bin(0, 170, 255))],
+        0.0
+    );
     let away = Ellipse::from_parts(12.0, 12.0, 4.0, 0.0, 4.0);
-    for method in [Method::EmLike(EmParams::default()), Method::MeanShift(MeanShiftParams::default())] {
+    for method in [
+        Method::EmLike(EmParams::default()),
+        Method::MeanShift(MeanShiftParams::default()),
+    ] {
         let lost = match method {
             Method::EmLike(p) => em_like(&cyan, &model, &away, &p),
             Method::MeanShift(p) => mean_shift_scaled(&cyan, &model, &away, &p),
@@ -327,7 +350,10 @@ fn bad_parameters_and_frames_are_errors() {
     assert!(em_like(&rgb.target, &model, &c.start, &EmParams::default()).is_err());
     let grey = vec![0u8; W * H];
     assert!(matches!(
-        BinImage::new(ImageView::new(&grey, W, H, 1).expect("view"), ColorSpace::Hs),
+        BinImage::new(
+            ImageView::new(&grey, W, H, 1).expect("view"),
+            ColorSpace::Hs
+        ),
         Err(ColorTrackError::Channels { channels: 1 })
     ));
 }

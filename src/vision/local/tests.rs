@@ -30,9 +30,14 @@ fn frame(k: u64, pan: i64, person: Option<(i64, i64)>) -> Vec<u8> {
                 1 => [140, 135, 125],
                 _ => [95, 105, 125],
             };
-            let inside = person.is_some_and(|(px, py)| x >= px && x < px + PW && y >= py && y < py + PH);
+            let inside =
+                person.is_some_and(|(px, py)| x >= px && x < px + PW && y >= py && y < py + PH);
             let c = if let (true, Some((_, py))) = (inside, person) {
-                if y < py + PH / 2 { [200, 40, 40] } else { [40, 60, 190] }
+                if y < py + PH / 2 {
+                    [200, 40, 40]
+                } else {
+                    [40, 60, 190]
+                }
             } else {
                 base
             };
@@ -78,7 +83,13 @@ fn one_near(obs: &[Observation], person: (i64, i64), tol: f64, what: &str) -> Ob
     assert_eq!(obs.len(), 1, "{what}: {obs:?}");
     let o = obs[0].clone();
     let d = (o.region.center - centre(person)).norm();
-    assert!(d < tol, "{what}: {d:.1} px from the person ({:?}): {:?} vs {:?}", o.mode, o, centre(person));
+    assert!(
+        d < tol,
+        "{what}: {d:.1} px from the person ({:?}): {:?} vs {:?}",
+        o.mode,
+        o,
+        centre(person)
+    );
     o
 }
 
@@ -93,7 +104,10 @@ fn one_on(obs: &[Observation], person: (i64, i64), what: &str) -> Observation {
         && c.x <= (person.0 + PW - 1) as f64
         && c.y >= person.1 as f64
         && c.y <= (person.1 + PH - 1) as f64;
-    assert!(inside, "{what}: centre {c:?} off the person at {person:?}: {o:?}");
+    assert!(
+        inside,
+        "{what}: centre {c:?} off the person at {person:?}: {o:?}"
+    );
     o
 }
 
@@ -140,7 +154,10 @@ fn walking_standing_and_walking_again_keeps_one_track() {
         "{modes:?}"
     );
     let absorbed = t.mask().iter().filter(|&&m| m == FOREGROUND).count();
-    assert!(absorbed < (PW * PH / 4) as usize, "person still in the mask: {absorbed} px");
+    assert!(
+        absorbed < (PW * PH / 4) as usize,
+        "person still in the mask: {absorbed} px"
+    );
     // walk on: the blob takes the track back (the ghost left behind does not)
     let mut back = false;
     for _ in 0..10 {
@@ -201,7 +218,10 @@ fn camera_motion_hands_over_to_the_colour_tracker_and_back() {
     assert_eq!(modes[0], Mode::Colour(HandOver::CameraMoving));
     assert_eq!(*modes.last().expect("frames"), Mode::Blob, "{modes:?}");
     let s = t.stats();
-    assert_eq!((s.handovers_camera, s.gmm_restarts, s.moving_frames), (1, 1, 12));
+    assert_eq!(
+        (s.handovers_camera, s.gmm_restarts, s.moving_frames),
+        (1, 1, 12)
+    );
 }
 
 #[test]
