@@ -18,6 +18,10 @@ seed = 7
 sessions = 1
 duration_s = 4.0
 
+[profiles.quick]
+sessions = 1
+duration_s = 4.0
+
 [world]
 kind = "room"
 size = [5.0, 5.0]
