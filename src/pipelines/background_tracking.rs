@@ -737,7 +737,7 @@ impl Experiment for BackgroundTracking {
             None
         };
         let colour_wanted =
-            p.colour.datasets.iter().any(|d| *d == s.info.dataset) && has_mask && !gt.is_empty();
+            p.colour.datasets.contains(&s.info.dataset) && has_mask && !gt.is_empty();
         let mut colour = ColourRun {
             trackers: Vec::new(),
             started: false,
@@ -1612,6 +1612,7 @@ fn colour_products(ctx: &Aggregate, p: &Params, products: &mut Products) -> anyh
     let mut t_lost = Vec::new();
     let mut t_paper = Vec::new();
     let mut samples: Vec<DataFrame> = Vec::new();
+    #[allow(clippy::type_complexity)]
     let mut tests: (
         Vec<String>,
         Vec<String>,

@@ -149,7 +149,7 @@ impl Blob {
 }
 
 fn check(mask_len: usize, width: usize, height: usize) -> Result<usize, BlobError> {
-    let need = width.checked_mul(height).unwrap_or(usize::MAX);
+    let need = width.saturating_mul(height);
     if mask_len != need {
         return Err(BlobError::MaskSize {
             have: mask_len,

@@ -279,7 +279,7 @@ fn histogram_of(space: ColorSpace, s: &[Sample]) -> Option<Histogram> {
         values[p.bin as usize] += p.g;
         total += p.g;
     }
-    if !(total > 0.0) {
+    if total.is_nan() || total <= 0.0 {
         return None;
     }
     values.iter_mut().for_each(|v| *v /= total);
@@ -563,7 +563,7 @@ pub fn em_like(
             sxy += q * dx * dy;
             syy += q * dy * dy;
         }
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return Ok(TrackResult::lost(*start, iterations));
         }
         let center = Point2::new(sx / total, sy / total);
@@ -615,7 +615,7 @@ pub fn mean_shift(
             sx += q * smp.x;
             sy += q * smp.y;
         }
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return Ok(TrackResult::lost(*start, iterations));
         }
         let center = Point2::new(sx / total, sy / total);

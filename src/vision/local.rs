@@ -29,6 +29,7 @@
 //!      moved its centroid less than `still_speed_px` per frame over the last `still_frames`
 //!      frames (the person stands still and will fade into the background). A track that
 //!      never moved (a ghost, a moved chair) is never handed over: it ends with its blob.
+//!
 //!    The colour model is the kernel-weighted histogram (eq. 17) of the track's last blob
 //!    ellipse, refreshed every frame the track is seen as a blob.
 //! 5. A blob track missed more than `max_missed` frames in a row ends.
