@@ -1,6 +1,7 @@
 //! The experiments, one module each, and the registry that maps a pipeline file's `kind` to
 //! its implementation.
 
+pub mod background_tracking;
 pub mod columns;
 pub mod dataset_quality;
 pub mod omni_appearance;
@@ -11,6 +12,7 @@ use crate::run::{Experiment, RunOptions, RunSummary, config, run_experiment, unk
 
 /// Every `pipeline.kind` this build knows.
 pub const KINDS: &[&str] = &[
+    background_tracking::BackgroundTracking::KIND,
     dataset_quality::DatasetQuality::KIND,
     omni_appearance::OmniAppearance::KIND,
 ];
@@ -19,6 +21,9 @@ pub const KINDS: &[&str] = &[
 pub fn run_file(path: &Path, opts: &RunOptions) -> anyhow::Result<RunSummary> {
     let (text, kind) = config::read_kind(path)?;
     match kind.as_str() {
+        background_tracking::BackgroundTracking::KIND => {
+            run_experiment::<background_tracking::BackgroundTracking>(path, &text, opts)
+        }
         dataset_quality::DatasetQuality::KIND => {
             run_experiment::<dataset_quality::DatasetQuality>(path, &text, opts)
         }

@@ -6,6 +6,15 @@
 //!   algorithm behind OpenCV's `BackgroundSubtractorMOG2`) and the Stauffer–Grimson baseline
 //!   with a fixed number of components; foreground / shadow / background masks, the
 //!   components-per-pixel image and the background image.
+//! - [`blobs`]: connected components of a mask (shadow pixels removed) with their moments,
+//!   and a 3×3 majority filter.
+//! - [`ellipse`]: a region as centre + 2×2 covariance, its axes, Mahalanobis distance and the
+//!   overlap (IoU) of two ellipses.
+//! - [`colortrack`]: colour-histogram tracking — the EM-like 5-DOF tracker (Zivkovic & Kröse,
+//!   CVPR 2004) and mean shift with the ±10 % scale test (Comaniciu et al., CVPR 2000); HS and
+//!   RGB histograms, Bhattacharyya similarity.
+//! - [`local`]: local tracks — GMM blobs tracked frame to frame, handed to the colour tracker
+//!   when the camera moves or the person stands still (the input of re-identification).
 //! - [`score`]: precision, recall and F-measure of a mask against a hand-segmented one.
 //! - [`synthetic`]: a deterministic synthetic RGB scene (textured background, noise, a
 //!   flickering region, a moving object with a shadow) for tests and benchmarks.
@@ -13,7 +22,11 @@
 //! Kernels read frames and write into buffers the caller owns; nothing here reads logs or
 //! writes files.
 
+pub mod blobs;
+pub mod colortrack;
+pub mod ellipse;
 pub mod gmm;
+pub mod local;
 pub mod omni;
 pub mod score;
 pub mod synthetic;

