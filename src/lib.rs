@@ -14,5 +14,7 @@ pub mod report;
 pub mod run;
 pub mod synth;
 pub mod time;
+pub mod track;
+pub mod vision;
 
 pub use time::Nanos;

@@ -2,13 +2,17 @@
 //! its implementation.
 
 pub mod dataset_quality;
+pub mod multicam_cylinders;
 
 use std::path::Path;
 
 use crate::run::{Experiment, RunOptions, RunSummary, config, run_experiment, unknown_kind};
 
 /// Every `pipeline.kind` this build knows.
-pub const KINDS: &[&str] = &[dataset_quality::DatasetQuality::KIND];
+pub const KINDS: &[&str] = &[
+    dataset_quality::DatasetQuality::KIND,
+    multicam_cylinders::MulticamCylinders::KIND,
+];
 
 /// Run one pipeline file, dispatching on its `kind`.
 pub fn run_file(path: &Path, opts: &RunOptions) -> anyhow::Result<RunSummary> {
@@ -16,6 +20,9 @@ pub fn run_file(path: &Path, opts: &RunOptions) -> anyhow::Result<RunSummary> {
     match kind.as_str() {
         dataset_quality::DatasetQuality::KIND => {
             run_experiment::<dataset_quality::DatasetQuality>(path, &text, opts)
+        }
+        multicam_cylinders::MulticamCylinders::KIND => {
+            run_experiment::<multicam_cylinders::MulticamCylinders>(path, &text, opts)
         }
         _ => Err(unknown_kind(path, &kind, KINDS).into()),
     }

@@ -1,0 +1,10 @@
+//! Tracking: filters and the trackers built on them. Pure computation on detections and
+//! camera geometry: no I/O.
+//!
+//! - [`kalman`]: linear Kalman filter, constant-velocity and random-walk models.
+//! - [`graph_match`]: 2-D tracking by graph matching of rectangles (seed 004 §4).
+//! - [`cylinders`]: multi-camera 3-D tracking of people as cylinders (seed 004 §5).
+
+pub mod cylinders;
+pub mod graph_match;
+pub mod kalman;
