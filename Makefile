@@ -2,8 +2,10 @@
 CARGO ?= cargo
 PYTHON ?= python3
 VENV := target/py-venv
+# py-motmetrics needs numpy 1, OpenCV 4.12 numpy 2: separate throwaway environments
+VENV_MOT := target/py-venv-mot
 
-.PHONY: help eval datasets release test bench interop clean
+.PHONY: help eval datasets release test bench interop clean opencv-agreement bench-gmm
 
 PROFILE ?= quick
 
@@ -14,6 +16,8 @@ help:
 	@echo "make bench     criterion benchmarks + the same reads in Python mcap-ros2-support, with ratios"
 	@echo "make bench-mot tracking metrics: criterion on a synthetic sequence + py-motmetrics on the same files, with the ratio"
 	@echo "make interop   check that Python mcap-ros2-support opens what we write, synthetic datasets included (throwaway venv)"
+	@echo "make opencv-agreement  pixel agreement of vision::gmm masks with OpenCV MOG2 (throwaway venv)"
+	@echo "make bench-gmm         adaptive GMM frames/s beside OpenCV MOG2 on the same frames, with ratios"
 	@echo "make clean     remove build outputs and out/"
 
 release:
@@ -46,17 +50,43 @@ bench: $(VENV)/ok
 	$(VENV)/bin/python tools/bench_python_read.py target/bench-data/python_read.json
 	$(VENV)/bin/python tools/bench_compare.py target/criterion target/bench-data/python_read.json
 	$(MAKE) bench-mot
+	$(MAKE) bench-gmm
 
 # py-motmetrics 1.4.0 calls np.asfarray, which numpy 2 removed: pin the last numpy 1 stack.
-$(VENV)/mot-ok:
-	$(PYTHON) -m venv $(VENV)
-	$(VENV)/bin/pip install --quiet --disable-pip-version-check motmetrics==1.4.0 numpy==1.26.4 pandas==2.2.3 scipy==1.13.1
+$(VENV_MOT)/mot-ok:
+	$(PYTHON) -m venv $(VENV_MOT)
+	$(VENV_MOT)/bin/pip install --quiet --disable-pip-version-check motmetrics==1.4.0 numpy==1.26.4 pandas==2.2.3 scipy==1.13.1
 	touch $@
 
 .PHONY: bench-mot
-bench-mot: $(VENV)/mot-ok
+bench-mot: $(VENV_MOT)/mot-ok
 	$(CARGO) bench --bench mot -- --noplot
-	$(VENV)/bin/python tools/bench_motmetrics.py target/bench-data/mot target/criterion 3
+	$(VENV_MOT)/bin/python tools/bench_motmetrics.py target/bench-data/mot target/criterion 3
+
+# OpenCV's MOG2 as the reference for vision::gmm, in the same throwaway venv (own stamp).
+$(VENV)/opencv-ok: $(VENV)/ok
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check opencv-python-headless==4.12.0.88 numpy==2.2.6
+	touch $@
+
+GMM_OUT := target/gmm-agreement
+WAVING_TREES := ../shared/real/wallflower_waving_trees/WavingTrees
+
+opencv-agreement: $(VENV)/opencv-ok
+	$(CARGO) run --quiet --release --example gmm_masks -- synthetic $(GMM_OUT)/synthetic
+	$(VENV)/bin/python tools/opencv_mog2_agreement.py $(GMM_OUT)/synthetic
+	$(CARGO) run --quiet --release --example gmm_masks -- synthetic-grey $(GMM_OUT)/synthetic_grey
+	$(VENV)/bin/python tools/opencv_mog2_agreement.py $(GMM_OUT)/synthetic_grey
+	$(CARGO) run --quiet --release --example gmm_masks -- synthetic $(GMM_OUT)/synthetic_sg --stauffer-grimson
+	$(VENV)/bin/python tools/opencv_mog2_agreement.py $(GMM_OUT)/synthetic_sg
+	@if [ -d $(WAVING_TREES) ]; then \
+		$(CARGO) run --quiet --release --example gmm_masks -- wallflower $(WAVING_TREES) $(GMM_OUT)/waving_trees && \
+		$(VENV)/bin/python tools/opencv_mog2_agreement.py $(GMM_OUT)/waving_trees; \
+	else echo "SKIPPED: $(WAVING_TREES) is absent"; fi
+
+bench-gmm: $(VENV)/opencv-ok
+	$(CARGO) bench --bench gmm -- --noplot
+	$(VENV)/bin/python tools/bench_opencv_mog2.py target/bench-data/opencv_mog2.json
+	$(VENV)/bin/python tools/bench_opencv_mog2.py --compare target/criterion target/bench-data/opencv_mog2.json
 
 clean:
 	$(CARGO) clean

@@ -1,8 +1,26 @@
-//! Image stages: background models, foreground segmentation and people detection on camera
-//! frames. Kernels take a source and write into a caller-owned destination; they do no I/O.
+//! Vision stages: image kernels that turn camera frames into per-pixel masks and detections.
 //!
+//! - [`view`]: [`ImageView`], a borrowed, checked, tightly packed 8-bit image (grey or colour)
+//!   that every kernel here reads.
+//! - [`gmm`]: adaptive Gaussian-mixture background subtraction (Zivkovic, ICPR 2004 — the
+//!   algorithm behind OpenCV's `BackgroundSubtractorMOG2`) and the Stauffer–Grimson baseline
+//!   with a fixed number of components; foreground / shadow / background masks, the
+//!   components-per-pixel image and the background image.
+//! - [`score`]: precision, recall and F-measure of a mask against a hand-segmented one.
+//! - [`synthetic`]: a deterministic synthetic RGB scene (textured background, noise, a
+//!   flickering region, a moving object with a shadow) for tests and benchmarks.
 //! - [`gabor`]: the Gabor-feature background model and MAD threshold of seed 004 §2.
 //! - [`template`]: human-silhouette template detection of seed 004 §3.
+//!
+//! Kernels read frames and write into buffers the caller owns; nothing here reads logs or
+//! writes files.
 
 pub mod gabor;
+pub mod gmm;
+pub mod score;
+pub mod synthetic;
 pub mod template;
+pub mod view;
+
+pub use gmm::{AdaptiveGmm, GmmError, GmmParams};
+pub use view::{ImageView, ViewError};

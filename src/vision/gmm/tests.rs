@@ -1,0 +1,472 @@
+//! Known answers for the recursion, and the vectorised kernel against the scalar reference.
+
+use super::reference::ReferenceGmm;
+use super::*;
+
+/// A deterministic generator (SplitMix64) so no test depends on an unseeded source.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+}
+
+fn model(params: GmmParams) -> AdaptiveGmm {
+    AdaptiveGmm::new(params).expect("valid parameters")
+}
+
+/// Feed one pixel (1x1 RGB frames) the colours `seq`; return the mask byte of each frame.
+fn run_pixel(m: &mut AdaptiveGmm, seq: &[[u8; 3]], lr: Option<f32>) -> Vec<u8> {
+    seq.iter()
+        .map(|px| {
+            let view = ImageView::new(px, 1, 1, 3).expect("1x1 rgb");
+            let mut mask = [0u8; 1];
+            m.apply(view, lr, &mut mask).expect("apply");
+            mask[0]
+        })
+        .collect()
+}
+
+fn comps(m: &AdaptiveGmm) -> Vec<Component> {
+    m.components(0, 0).expect("pixel (0, 0)")
+}
+
+#[test]
+fn constant_pixel_is_one_component_of_weight_one() {
+    // Frame 1 starts the component with π = 1; eq. 14 then maps π = 1 to
+    // ((1 - α) + α - αc_T) / (1 - αc_T) = 1 every frame, and |x - µ| = 0 shrinks σ² by
+    // (1 - α/π) each frame down to the clamp fVarMin.
+    let mut m = model(GmmParams::default());
+    let masks = run_pixel(&mut m, &[[90, 120, 30]; 1000], None);
+    let c = comps(&m);
+    assert_eq!(c.len(), 1);
+    assert!((c[0].weight - 1.0).abs() <= 1e-6, "{c:?}");
+    assert_eq!(c[0].variance, DEFAULT_VAR_MIN);
+    assert_eq!(c[0].mean, [90.0, 120.0, 30.0]);
+    assert!(masks[1..].iter().all(|&v| v == BACKGROUND));
+    assert_eq!(m.components_per_pixel(), vec![1]);
+    assert_eq!(m.background_image().expect("seen"), vec![90, 120, 30]);
+}
+
+/// Weights after frame 1 at colour A and `n` frames at colour B with a fixed α, by the
+/// recursion (eq. 14 then renormalisation, new component at π = α), in f64.
+fn expected_two_colours(alpha: f64, ct: f64, n: usize) -> (f64, Option<f64>) {
+    let (mut wa, mut wb) = (Some(1.0f64), None::<f64>);
+    for _ in 0..n {
+        let prune = -alpha * ct;
+        let a = wa.map(|w| (1.0 - alpha) * w + prune);
+        let a = a.filter(|&w| w >= -prune);
+        match wb {
+            None => {
+                // B is new: normalise A (the only weight, so the total is A itself), then B
+                // takes α and A is scaled by 1 - α.
+                let total = a.unwrap_or(1.0);
+                wa = a.map(|w| w / total * (1.0 - alpha));
+                wb = Some(alpha);
+            }
+            Some(b) => {
+                let b = (1.0 - alpha) * b + prune + alpha;
+                let total = b + a.unwrap_or(0.0);
+                wa = a.map(|w| w / total);
+                wb = Some(b / total);
+            }
+        }
+    }
+    (wb.unwrap_or(0.0), wa)
+}
+
+#[test]
+fn weight_after_n_frames_follows_the_recursion() {
+    const ALPHA: f32 = 0.01;
+    const N: usize = 200;
+    for ct in [0.0f32, DEFAULT_COMPLEXITY_REDUCTION] {
+        let mut m = model(GmmParams {
+            complexity_reduction: ct,
+            ..GmmParams::default()
+        });
+        let mut seq = vec![[50u8, 50, 50]];
+        seq.extend([[200u8, 200, 200]; N]);
+        run_pixel(&mut m, &seq, Some(ALPHA));
+        let (wb, wa) = expected_two_colours(f64::from(ALPHA), f64::from(ct), N);
+        let c = comps(&m);
+        if ct == 0.0 {
+            // Without the prior the closed form holds: π_B = 1 - (1 - α)^N.
+            assert!((wb - (1.0 - (1.0 - f64::from(ALPHA)).powi(N as i32))).abs() < 1e-12);
+        }
+        assert_eq!(c[0].mean, [200.0; 3], "ct {ct}: B leads");
+        assert!(
+            (f64::from(c[0].weight) - wb).abs() < 1e-5,
+            "ct {ct}: {c:?} vs {wb}"
+        );
+        match wa {
+            Some(wa) => {
+                assert_eq!(c.len(), 2, "ct {ct}");
+                assert!((f64::from(c[1].weight) - wa).abs() < 1e-5, "{c:?} vs {wa}");
+            }
+            None => assert_eq!(c.len(), 1, "ct {ct}: A was dropped"),
+        }
+    }
+}
+
+#[test]
+fn alternating_pixel_keeps_two_components() {
+    let mut m = model(GmmParams::default());
+    let seq: Vec<[u8; 3]> = (0..2000)
+        .map(|i| if i % 2 == 0 { [100; 3] } else { [160, 40, 90] })
+        .collect();
+    let masks = run_pixel(&mut m, &seq, None);
+    let c = comps(&m);
+    assert_eq!(c.len(), 2, "{c:?}");
+    for comp in &c {
+        assert!((comp.weight - 0.5).abs() < 0.01, "{c:?}");
+        assert_eq!(comp.variance, DEFAULT_VAR_MIN);
+    }
+    // Both modes are background once each has ~half the weight.
+    assert!(masks[1000..].iter().all(|&v| v == BACKGROUND));
+}
+
+/// Object frames (1-based) until a static object that covers a trained background pixel
+/// becomes background, with a fixed α.
+fn frames_until_background(params: GmmParams, alpha: f32) -> usize {
+    let mut m = model(params);
+    run_pixel(&mut m, &[[60, 60, 60]; 300], None);
+    let masks = run_pixel(&mut m, &[[200, 40, 90]; 400], Some(alpha));
+    let first = masks
+        .iter()
+        .position(|&v| v == BACKGROUND)
+        .expect("absorbed")
+        + 1;
+    assert!(masks[..first - 1].iter().all(|&v| v == FOREGROUND));
+    assert!(masks[first - 1..].iter().all(|&v| v == BACKGROUND));
+    first
+}
+
+#[test]
+fn static_object_becomes_background_after_the_papers_frame_count() {
+    // Section 3: the object's component joins the background when the old one's weight
+    // (1 - α)^k drops below 1 - c_f, i.e. after log(1 - c_f) / log(1 - α) = 105.3 frames
+    // for c_f = 0.1, α = 0.001 ("we get 105 frames"): foreground for 105 frames, background
+    // from the 106th. The margin (0.999^105 - 0.9 = 2.8e-4) is far above f32 rounding, so
+    // the frame is exact without the prior.
+    let paper = (0.9f64.ln() / 0.999f64.ln()).ceil() as usize;
+    assert_eq!(paper, 106);
+    assert_eq!(
+        frames_until_background(GmmParams::stauffer_grimson(), 0.001),
+        paper
+    );
+
+    // With the prior (c_T = 0.05) both weights lose αc_T a frame and are then renormalised,
+    // which changes the old weight's decay; the recursion in f64 gives the frame. Allowed ±1: our
+    // f32 recursion and the f64 one may round a weight within ~1e-6 of 0.9 differently.
+    let alpha = 0.001f64;
+    let ct = f64::from(DEFAULT_COMPLEXITY_REDUCTION);
+    let (mut old, mut new) = (1.0 - alpha, alpha);
+    let mut expected = 0;
+    for k in 2.. {
+        old = (1.0 - alpha) * old - alpha * ct;
+        if old < 0.9 {
+            expected = k;
+            break;
+        }
+        new = (1.0 - alpha) * new - alpha * ct + alpha;
+        let total = old + new;
+        (old, new) = (old / total, new / total);
+    }
+    let got = frames_until_background(GmmParams::default(), 0.001);
+    assert!(
+        got.abs_diff(expected) <= 1,
+        "got {got}, recursion {expected}"
+    );
+    eprintln!("with the prior: {got} frames (recursion {expected})");
+}
+
+#[test]
+fn darker_background_is_shadow_other_hue_is_foreground() {
+    for detect in [true, false] {
+        let params = GmmParams {
+            detect_shadows: detect,
+            ..GmmParams::default()
+        };
+        let shadow = if detect {
+            DEFAULT_SHADOW_VALUE
+        } else {
+            FOREGROUND
+        };
+        let bg = [200u8, 150, 100];
+        let check = |px: [u8; 3], want: u8| {
+            let mut m = model(params);
+            run_pixel(&mut m, &[bg; 100], None);
+            assert_eq!(run_pixel(&mut m, &[px], None), vec![want], "{px:?}");
+        };
+        check([140, 105, 70], shadow); // 0.7 x background
+        check([110, 82, 55], shadow); // 0.55 x: still within τ = 0.5
+        check([90, 68, 45], FOREGROUND); // 0.45 x: darker than τ allows
+        check([100, 150, 200], FOREGROUND); // another hue
+        check([240, 180, 120], FOREGROUND); // brighter
+        check([201, 150, 99], BACKGROUND);
+    }
+    // Grey frames: a darker grey is a shadow too.
+    let mut m = model(GmmParams::default());
+    let mut mask = [0u8];
+    for v in [[200u8]; 50].iter().chain([[140u8]].iter()) {
+        m.apply(ImageView::new(v, 1, 1, 1).expect("1x1"), None, &mut mask)
+            .expect("apply");
+    }
+    assert_eq!(mask[0], DEFAULT_SHADOW_VALUE);
+}
+
+#[test]
+fn first_frame_matches_opencv() {
+    // OpenCV's first frame: a new component per pixel, no component was there to call the
+    // pixel background, and the pixel is "a darker copy" (a = 1) of its new component, so
+    // every non-black pixel is a shadow and a black one is foreground.
+    let mut m = model(GmmParams::default());
+    let frame = [0u8, 0, 0, 10, 20, 30];
+    let mut mask = [9u8; 2];
+    m.apply(
+        ImageView::new(&frame, 2, 1, 3).expect("2x1"),
+        None,
+        &mut mask,
+    )
+    .expect("apply");
+    assert_eq!(mask, [FOREGROUND, DEFAULT_SHADOW_VALUE]);
+}
+
+#[test]
+fn learning_rate_zero_freezes_and_one_restarts() {
+    let mut m = model(GmmParams::default());
+    run_pixel(&mut m, &[[10, 10, 10]; 20], None);
+    let before = comps(&m);
+    // α = 0: no weight moves and no component is created.
+    assert_eq!(
+        run_pixel(&mut m, &[[250, 10, 10]; 5], Some(0.0)),
+        vec![FOREGROUND; 5]
+    );
+    assert_eq!(comps(&m), before);
+    // α ≥ 1: the model restarts from this frame (OpenCV's rule).
+    run_pixel(&mut m, &[[250, 10, 10]], Some(1.0));
+    assert_eq!(m.frames_seen(), 1);
+    assert_eq!(comps(&m).len(), 1);
+    assert_eq!(comps(&m)[0].mean, [250.0, 10.0, 10.0]);
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let mut m = model(GmmParams::default());
+    let rgb = [0u8; 12];
+    let view = ImageView::new(&rgb, 2, 2, 3).expect("2x2");
+    let mut mask = [0u8; 3];
+    assert!(matches!(
+        m.apply(view, None, &mut mask),
+        Err(GmmError::MaskSize { have: 3, need: 4 })
+    ));
+    let mut mask = [0u8; 4];
+    let rgba = [0u8; 16];
+    let four = ImageView::new(&rgba, 2, 2, 4).expect("2x2x4");
+    assert!(matches!(
+        m.apply(four, None, &mut mask),
+        Err(GmmError::UnsupportedChannels { channels: 4 })
+    ));
+    assert!(matches!(
+        m.apply(view, Some(-0.5), &mut mask),
+        Err(GmmError::BadLearningRate(_))
+    ));
+    assert!(matches!(
+        m.apply(view, Some(f32::NAN), &mut mask),
+        Err(GmmError::BadLearningRate(_))
+    ));
+    assert_eq!(m.frames_seen(), 0, "a refused frame changes nothing");
+    m.apply(view, None, &mut mask).expect("first frame");
+    let grey = [0u8; 4];
+    let g = ImageView::new(&grey, 2, 2, 1).expect("2x2x1");
+    assert!(matches!(
+        m.apply(g, None, &mut mask),
+        Err(GmmError::ShapeMismatch { .. })
+    ));
+    assert!(matches!(
+        m.components(2, 0),
+        Err(GmmError::OutOfBounds { .. })
+    ));
+    m.reset();
+    m.apply(g, None, &mut mask).expect("after reset any shape");
+    assert!(matches!(
+        model(GmmParams::default()).background_image(),
+        Err(GmmError::NoFrames)
+    ));
+    for p in [
+        GmmParams {
+            n_mixtures: 0,
+            ..GmmParams::default()
+        },
+        GmmParams {
+            n_mixtures: MAX_MIXTURES + 1,
+            ..GmmParams::default()
+        },
+        GmmParams {
+            history: 0,
+            ..GmmParams::default()
+        },
+        GmmParams {
+            var_threshold: f32::NAN,
+            ..GmmParams::default()
+        },
+        GmmParams {
+            var_init: -1.0,
+            ..GmmParams::default()
+        },
+    ] {
+        assert!(matches!(
+            AdaptiveGmm::new(p),
+            Err(GmmError::BadParam { .. })
+        ));
+    }
+}
+
+/// Frames that exercise every path: per-pixel multimodal backgrounds, noise, objects that
+/// come and stay, dark copies (shadows), black pixels (shadow test's zero denominator).
+fn stress_frames(w: usize, h: usize, c: usize, n: usize, seed: u64) -> Vec<Vec<u8>> {
+    let mut rng = Rng(seed);
+    let modes: Vec<[u8; 6]> = (0..w * h)
+        .map(|_| std::array::from_fn(|_| rng.below(256) as u8))
+        .collect();
+    (0..n)
+        .map(|t| {
+            let mut f = vec![0u8; w * h * c];
+            for p in 0..w * h {
+                let r = rng.below(100);
+                let base: [u8; 3] = if r < 60 {
+                    [modes[p][0], modes[p][1], modes[p][2]]
+                } else if r < 80 {
+                    [modes[p][3], modes[p][4], modes[p][5]]
+                } else if r < 88 {
+                    let k = 4 + rng.below(7);
+                    let s = |v: u8| (u32::from(v) * k as u32 / 10) as u8;
+                    [s(modes[p][0]), s(modes[p][1]), s(modes[p][2])]
+                } else if r < 92 || (t > n / 2 && p % 7 == 0) {
+                    [0, 0, 0]
+                } else {
+                    std::array::from_fn(|_| rng.below(256) as u8)
+                };
+                for ch in 0..c {
+                    let noise = rng.below(9) as i32 - 4;
+                    f[p * c + ch] = (i32::from(base[ch]) + noise).clamp(0, 255) as u8;
+                }
+            }
+            f
+        })
+        .collect()
+}
+
+fn assert_same_state(m: &AdaptiveGmm, r: &ReferenceGmm, w: usize, frame: usize) {
+    for p in 0..r.used.len() {
+        let got = m.components(p % w, p / w).expect("in bounds");
+        assert_eq!(got.len(), r.used[p], "frame {frame} pixel {p}");
+        for (g, s) in got.iter().zip(&r.slots[p]) {
+            assert_eq!(
+                g.weight.to_bits(),
+                s.weight.to_bits(),
+                "frame {frame} px {p}"
+            );
+            assert_eq!(g.variance.to_bits(), s.variance.to_bits());
+            for ch in 0..r.channels {
+                assert_eq!(g.mean[ch].to_bits(), s.mean[ch].to_bits());
+            }
+        }
+    }
+}
+
+#[test]
+fn kernel_matches_scalar_reference_bit_for_bit() {
+    let tight = GmmParams {
+        n_mixtures: 3,
+        var_threshold_gen: 4.0,
+        complexity_reduction: 0.3,
+        history: 40,
+        ..GmmParams::default()
+    };
+    let cases = [
+        (GmmParams::default(), 3, None),
+        (GmmParams::default(), 1, None),
+        (GmmParams::stauffer_grimson(), 3, Some(0.02)),
+        (tight, 3, None),
+        (tight, 1, Some(0.05)),
+        (
+            GmmParams {
+                n_mixtures: 1,
+                ..GmmParams::default()
+            },
+            3,
+            None,
+        ),
+    ];
+    let (w, h, n) = (13, 5, 120);
+    let isas = Isa::available();
+    for (i, (params, c, lr)) in cases.into_iter().enumerate() {
+        for &isa in &isas {
+            let frames = stress_frames(w, h, c, n, 7 + i as u64);
+            let mut m = model(params);
+            let mut r = ReferenceGmm::new(params, w * h, c);
+            let (mut got, mut want) = (vec![0u8; w * h], vec![0u8; w * h]);
+            for (t, f) in frames.iter().enumerate() {
+                let view = ImageView::new(f, w, h, c).expect("frame");
+                m.apply_with(isa, view, lr, &mut got).expect("apply");
+                r.apply(f, lr, &mut want);
+                assert_eq!(got, want, "case {i} frame {t}");
+                assert_same_state(&m, &r, w, t);
+            }
+            let max = m.components_per_pixel().into_iter().max().unwrap_or(0);
+            assert!(usize::from(max) == params.n_mixtures, "case {i} fills M");
+        }
+    }
+}
+
+#[test]
+fn save_load_round_trip_and_corrupt_input() {
+    let (w, h) = (11, 3);
+    let frames = stress_frames(w, h, 3, 40, 99);
+    let mut m = model(GmmParams::default());
+    let mut mask = vec![0u8; w * h];
+    for f in &frames[..20] {
+        m.apply(ImageView::new(f, w, h, 3).expect("f"), None, &mut mask)
+            .expect("apply");
+    }
+    let mut bytes = Vec::new();
+    m.save(&mut bytes).expect("save");
+    let mut back = AdaptiveGmm::load(&mut bytes.as_slice()).expect("load");
+    let mut again = Vec::new();
+    back.save(&mut again).expect("save again");
+    assert_eq!(bytes, again);
+    let mut mask2 = vec![0u8; w * h];
+    for f in &frames[20..] {
+        let v = ImageView::new(f, w, h, 3).expect("f");
+        m.apply(v, None, &mut mask).expect("apply");
+        back.apply(v, None, &mut mask2).expect("apply");
+        assert_eq!(mask, mask2);
+    }
+    for cut in 0..bytes.len() {
+        assert!(
+            AdaptiveGmm::load(&mut &bytes[..cut]).is_err(),
+            "prefix {cut}"
+        );
+    }
+    let mut long = bytes.clone();
+    long.push(0);
+    assert!(AdaptiveGmm::load(&mut long.as_slice()).is_err());
+    let mut wrong = bytes.clone();
+    wrong[0] = b'X';
+    assert!(AdaptiveGmm::load(&mut wrong.as_slice()).is_err());
+    // An unused model round-trips too.
+    let fresh = model(GmmParams::stauffer_grimson());
+    let mut b = Vec::new();
+    fresh.save(&mut b).expect("save");
+    let back = AdaptiveGmm::load(&mut b.as_slice()).expect("load");
+    assert_eq!(back.params(), &GmmParams::stauffer_grimson());
+    assert_eq!(back.shape(), None);
+}
