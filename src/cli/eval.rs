@@ -53,6 +53,7 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         out: a.out.clone(),
         git_commit: super::git_commit(),
         progress: super::stderr_is_terminal(),
+        write_tracks: None,
     };
     let mut runs = Vec::new();
     for f in &files {

@@ -66,6 +66,9 @@ pub struct Products {
 pub struct Aggregate<'a> {
     pub sessions: &'a [(SessionRef, Frames)],
     pub provenance: Provenance,
+    /// `--write-tracks`: folder for copies of the logs with the tracks added (pipelines that
+    /// produce tracks; others ignore it).
+    pub write_tracks: Option<&'a Path>,
 }
 
 /// One experiment (paper reproduction) as the runner drives it.
@@ -114,6 +117,8 @@ pub struct RunOptions {
     pub git_commit: String,
     /// Show progress bars (off in tests).
     pub progress: bool,
+    /// Write tracks back into copies of the logs under this folder (`--write-tracks`).
+    pub write_tracks: Option<PathBuf>,
 }
 
 /// What a run did, for the report.
@@ -440,6 +445,7 @@ pub fn run_experiment<E: Experiment>(
         &Aggregate {
             sessions: &done,
             provenance: provenance.clone(),
+            write_tracks: opts.write_tracks.as_deref(),
         },
         &file.params,
     )?;

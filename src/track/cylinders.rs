@@ -788,7 +788,7 @@ mod tests {
         let params = CylinderParams::default();
         let mut t = CylinderTracker::new(views.clone(), params).expect("tracker");
         let mut first_seen = None;
-        for k in 0..40 {
+        for k in 0..40u32 {
             let s = f64::from(k) * 0.04;
             let people = [(1, 2.0 + s, 3.0, 1.75, 0.22), (2, 6.0 - s, 5.5, 1.62, 0.2)];
             let (cyl, _) = t.step(&objects_for(&views, &people));
@@ -806,7 +806,7 @@ mod tests {
             }
         }
         // promoted on the N_app-th frame (index N_app − 1)
-        assert_eq!(first_seen, Some(params.n_app as usize - 1));
+        assert_eq!(first_seen, Some(params.n_app - 1));
     }
 
     #[test]

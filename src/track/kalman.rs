@@ -80,7 +80,7 @@ mod tests {
     use super::*;
     use nalgebra::{Matrix1, Matrix2x4, Vector1, Vector2, Vector4};
 
-    fn is_psd_symmetric<const N: usize>(p: &SMatrix<f64, N, N>) -> bool {
+    fn is_psd_symmetric(p: &SMatrix<f64, 4, 4>) -> bool {
         (p - p.transpose()).norm() < 1e-12
             && p.symmetric_eigenvalues().iter().all(|&e| e > -1e-12)
     }

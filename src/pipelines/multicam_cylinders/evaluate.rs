@@ -5,7 +5,7 @@
 //! sessions, as motmetrics' `OVERALL` row.
 
 use std::collections::{BTreeMap, HashMap};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use polars::prelude::*;
@@ -162,7 +162,6 @@ pub(super) struct SessionData {
     pub dt_s: f64,
     pub duration_s: f64,
     pub frames: i64,
-    pub first_stamp_ns: i64,
     pub decode_failures: i64,
     pub first_error: String,
 }
@@ -192,7 +191,6 @@ fn load(ctx: &Aggregate) -> anyhow::Result<Vec<SessionData>> {
             dt_s: f64s(session, "dt_s")?.first().copied().unwrap_or(0.04),
             duration_s: f64s(session, "duration_s")?.first().copied().unwrap_or(0.0),
             frames: i64s(session, "frames")?.first().copied().unwrap_or(0),
-            first_stamp_ns: i64s(session, "first_stamp_ns")?.first().copied().unwrap_or(0),
             decode_failures: i64s(session, "decode_failures")?.first().copied().unwrap_or(0),
             first_error: strs(session, "first_error")?.first().cloned().unwrap_or_default(),
         });
@@ -456,8 +454,12 @@ pub(crate) fn aggregate(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products>
             .summary
             .push(format!("Camera-view figure not drawn: {e:#}")),
     }
-    if !p.write_tracks.is_empty() {
-        for line in super::markers::write_all(&scored, p)? {
+    let tracks_dir = ctx
+        .write_tracks
+        .map(Path::to_path_buf)
+        .or_else(|| (!p.write_tracks.is_empty()).then(|| PathBuf::from(&p.write_tracks)));
+    if let Some(dir) = tracks_dir {
+        for line in super::markers::write_all(&scored, p, &dir)? {
             products.summary.push(line);
         }
     }

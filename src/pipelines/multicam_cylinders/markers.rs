@@ -120,8 +120,8 @@ pub(crate) fn write_tracks(
     Ok(frames.len())
 }
 
-/// Write every session's tracks (main run) under `write_tracks`.
-pub(super) fn write_all(s: &Scored, p: &Params) -> anyhow::Result<Vec<String>> {
+/// Write every session's tracks (main run) under `dir`.
+pub(super) fn write_all(s: &Scored, p: &Params, dir: &Path) -> anyhow::Result<Vec<String>> {
     let mut lines = Vec::new();
     for d in &s.data {
         let t = &d.tracks;
@@ -135,7 +135,7 @@ pub(super) fn write_all(s: &Scored, p: &Params) -> anyhow::Result<Vec<String>> {
                 f.1.push((t.id[i], t.x[i], t.y[i], t.h[i], t.r[i], t.cameras[i]));
             }
         }
-        let out = Path::new(&p.write_tracks)
+        let out = dir
             .join(&d.dataset)
             .join(format!("{}_tracks.mcap", d.name));
         let n = write_tracks(&d.path, &out, &p.tracks_topic, &p.world_frame, 2.0 * d.dt_s, &frames)

@@ -46,7 +46,6 @@ pub(crate) fn main_detector(p: &Params) -> &'static str {
 /// The cameras of one session with their calibration.
 #[derive(Debug, Clone)]
 pub(crate) struct Calibration {
-    pub infos: Vec<CameraInfo>,
     pub views: Vec<CalibratedView>,
 }
 
@@ -58,7 +57,6 @@ pub(crate) fn read_calibration(
 ) -> anyhow::Result<Calibration> {
     let file = log.path().display().to_string();
     let tf = TfBuffer::from_log(log, 0.0)?;
-    let mut infos = Vec::new();
     let mut views = Vec::new();
     for (cam, topic) in p.cameras.iter().zip(&t.info) {
         let (_, info) = read_topic::<CameraInfo>(log, topic)?
@@ -80,9 +78,8 @@ pub(crate) fn read_calibration(
             )
         })?;
         views.push(CalibratedView::new(model, world_from_camera));
-        infos.push(info);
     }
-    Ok(Calibration { infos, views })
+    Ok(Calibration { views })
 }
 
 /// What one camera contributes to one frame.
