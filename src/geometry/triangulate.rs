@@ -14,7 +14,7 @@
 //! What it does not do: no non-linear refinement (the paper uses the linear method), no
 //! outlier rejection, no uncertainty.
 
-use nalgebra::{DMatrix, Isometry3, Point2, Point3, Vector3};
+use nalgebra::{Isometry3, Matrix3, Matrix3x4, Matrix4, Point2, Point3, Vector3};
 
 use super::camera::CameraModel;
 
@@ -118,7 +118,8 @@ pub fn triangulate_dlt(
 
 /// The DLT on rays already in the world (`origin`, unit `direction`): each contributes the
 /// three rows of `[d]ₓ · (X − o) = 0`, and `X` is the null vector of the stacked homogeneous
-/// system (smallest singular value). For speed when the same pixels are tried in many
+/// system (smallest singular value, computed as the smallest eigenvector of its 4 × 4 normal
+/// matrix). For speed when the same pixels are tried in many
 /// combinations (seed 004's exhaustive search), rays are computed once by the caller.
 pub fn triangulate_rays(
     rays: &[(Point3<f64>, Vector3<f64>)],
@@ -132,26 +133,36 @@ pub fn triangulate_rays(
     let mean = rays.iter().fold(Vector3::zeros(), |a, (o, _)| a + o.coords) / n;
     let spread = rays.iter().map(|(o, _)| (o.coords - mean).norm()).sum::<f64>() / n;
     let scale = if spread > 1e-12 { spread } else { 1.0 };
-    let mut a = DMatrix::<f64>::zeros(3 * rays.len(), 4);
-    for (k, (origin, d)) in rays.iter().enumerate() {
-        let cross = nalgebra::Matrix3::new(0.0, -d.z, d.y, d.z, 0.0, -d.x, -d.y, d.x, 0.0);
+    // X is the right singular vector of the stacked 3k × 4 system A with the smallest
+    // singular value, i.e. the eigenvector of the 4 × 4 AᵀA with the smallest eigenvalue:
+    // accumulated row block by row block, no allocation (the exhaustive search of seed 004
+    // triangulates millions of combinations).
+    let mut ata = Matrix4::<f64>::zeros();
+    for (origin, d) in rays {
+        let cross = Matrix3::new(0.0, -d.z, d.y, d.z, 0.0, -d.x, -d.y, d.x, 0.0);
         let rhs = cross * (mean - origin.coords);
-        for i in 0..3 {
-            for j in 0..3 {
-                a[(3 * k + i, j)] = cross[(i, j)] * scale;
-            }
-            a[(3 * k + i, 3)] = rhs[i];
-        }
+        let mut block = Matrix3x4::<f64>::zeros();
+        block.fixed_view_mut::<3, 3>(0, 0).copy_from(&(cross * scale));
+        block.set_column(3, &rhs);
+        ata += block.transpose() * block;
     }
-    let svd = a.svd(false, true);
-    let v_t = svd.v_t.ok_or(TriangulateError::Degenerate)?;
-    let imin = svd
-        .singular_values
-        .iter()
-        .enumerate()
-        .fold((0, f64::INFINITY), |acc, (i, &s)| if s < acc.1 { (i, s) } else { acc })
-        .0;
-    let x = v_t.row(imin);
+    let eig = ata.symmetric_eigen();
+    if !eig.eigenvalues.iter().all(|v| v.is_finite()) {
+        return Err(TriangulateError::Degenerate);
+    }
+    let imin = eig.eigenvalues.imin();
+    // degenerate rays (parallel, or one ray only in effect): a second eigenvalue near zero
+    let mut sorted = [
+        eig.eigenvalues[0],
+        eig.eigenvalues[1],
+        eig.eigenvalues[2],
+        eig.eigenvalues[3],
+    ];
+    sorted.sort_by(f64::total_cmp);
+    if sorted[1] <= 1e-12 * sorted[3].max(1e-300) {
+        return Err(TriangulateError::Degenerate);
+    }
+    let x = eig.eigenvectors.column(imin);
     if x[3].abs() < 1e-12 {
         return Err(TriangulateError::Degenerate);
     }
@@ -253,6 +264,16 @@ mod tests {
                 check(&[views[1].clone(), views[3].clone()], p);
             }
         }
+    }
+
+    #[test]
+    fn parallel_rays_are_degenerate() {
+        let d = Vector3::new(0.0, 0.6, 0.8);
+        let rays = [
+            (Point3::new(0.0, 0.0, 0.0), d),
+            (Point3::new(1.0, 0.0, 0.0), d),
+        ];
+        assert_eq!(triangulate_rays(&rays), Err(TriangulateError::Degenerate));
     }
 
     #[test]

@@ -176,17 +176,22 @@ pub struct Hypothesis {
     pub head_m: Point3<f64>,
     /// `E_m` (eq. 4), pixels.
     pub e_m_px: f64,
-    /// `E_c` (eq. 5).
+    /// `E_c` (eq. 5), with `E_m` floored at [`E_M_FLOOR_PX`].
     pub e_c: f64,
     /// Radius by eq. 6 (m).
     pub radius_m: f64,
 }
 
+/// Reprojection errors below this (pixels) are rounding noise: the selection treats them as
+/// equal, so that with noise-free input E_c still prefers more cameras instead of whichever
+/// subset rounds closest to zero.
+pub const E_M_FLOOR_PX: f64 = 1e-6;
+
 impl Hypothesis {
     fn score(&self, s: Selection) -> f64 {
         match s {
             Selection::Corrected => self.e_c,
-            Selection::Mean => self.e_m_px,
+            Selection::Mean => self.e_m_px.max(E_M_FLOOR_PX),
         }
     }
 }
@@ -372,7 +377,7 @@ impl CylinderTracker {
             support: combo.iter().map(|&i| (prepared[i].camera, prepared[i].id)).collect(),
             head_m: head,
             e_m_px: e_m,
-            e_c: e_m / 10f64.powi(n as i32),
+            e_c: e_m.max(E_M_FLOOR_PX) / 10f64.powi(n as i32),
             radius_m: cylinder_radius(&head, &support3),
         })
     }
@@ -757,14 +762,53 @@ mod tests {
     }
 
     #[test]
-    fn eq6_recovers_the_radius_of_a_standing_cylinder_from_its_boxes() {
-        // A 1.75 m cylinder of radius 0.22 m at several places, boxes from the projected
-        // surface in the four office cameras (no distortion). Eq. 6 is a small-object, radial
-        // approximation: it scales the horizontal box width as if it were measured along the
-        // radial image direction at the head's depth, while the box is spread by the
-        // perspective of a 1.75 m tall body seen from 2.85 m and its nearest rim is closer
-        // than the head's centre. Measured here: within 20 % per camera and 12 % on the mean
-        // over the supporting cameras, which is the tolerance asserted.
+    fn eq6_inverts_the_box_of_a_standing_cylinder_seen_by_a_level_camera() {
+        // A level camera at head height sees a vertical cylinder (radius R, axis at horizontal
+        // distance D, azimuth α off the optical axis) as a box bounded by two vertical lines,
+        // the images of the tangent rays at azimuths α ± δ, δ = asin(R/D); the head is at
+        // (β·tan α, 0) from the principal point. Its width w = β·(tan(α+δ) − tan(α−δ)), and
+        // eq. 6 gives ½·(tan(α+δ) − tan(α−δ))·cos²α·D, which is R up to O((R/D)²): within
+        // 1 % here. Without the cos²α factor it would be off by 1/cos²α (33 % at 30°).
+        let pin = Pinhole::from_fov(352, 288, 78.0);
+        let (h, r) = (1.7, 0.22);
+        for d in [3.0, 4.5, 6.0] {
+            for alpha_deg in [0.0f64, 10.0, 20.0, 30.0] {
+                let a = alpha_deg.to_radians();
+                let eye = Point3::new(0.0, 0.0, h);
+                let view = CalibratedView::new(
+                    CameraModel::Pinhole(pin.clone()),
+                    look_at(eye, Point3::new(1.0, 0.0, h)),
+                );
+                let (x, y) = (d * a.cos(), d * a.sin());
+                let head = Point3::new(x, y, h);
+                let px = view.project(&head).expect("head visible");
+                // the box: extreme columns of the densely sampled rim (any height: the
+                // outline is vertical)
+                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+                for k in 0..36_000 {
+                    let t = f64::from(k) * std::f64::consts::TAU / 36_000.0;
+                    let p = view
+                        .project(&Point3::new(x + r * t.cos(), y + r * t.sin(), 0.5))
+                        .expect("visible");
+                    lo = lo.min(p.x);
+                    hi = hi.max(p.x);
+                }
+                let got = cylinder_radius(&head, &[(&view, [px.x, px.y], hi - lo)]);
+                let delta = (r / d).asin();
+                let closed = 0.5 * ((a + delta).tan() - (a - delta).tan()) * a.cos().powi(2) * d;
+                assert!((got - closed).abs() < 1e-6, "D {d} α {alpha_deg}: {got} vs {closed}");
+                assert!((got - r).abs() / r < 0.01, "D {d} α {alpha_deg}: {got}");
+            }
+        }
+    }
+
+    #[test]
+    fn eq6_on_the_office_cameras_is_a_biased_approximation() {
+        // The same cylinder seen from the office's corner cameras (2.85 m, looking down):
+        // the box is spread by the perspective of the whole 1.75 m body, which eq. 6 (a
+        // small-object, radial approximation at the head) does not model, so it
+        // overestimates, most for a near camera looking steeply down. Measured bounds:
+        // asserted so that a change in eq. 6 or the projection shows.
         let views = office_views(false);
         let (h, r) = (1.75, 0.22);
         for &(x, y) in &[(4.0, 4.25), (2.5, 6.0), (6.0, 2.0), (3.0, 2.0)] {
@@ -774,11 +818,13 @@ mod tests {
                 let px = v.project(&head).expect("head visible");
                 let b = cylinder_box(v, x, y, h, r).expect("visible");
                 let one = cylinder_radius(&head, &[(v, [px.x, px.y], b[2] - b[0])]);
-                assert!((one - r).abs() / r < 0.2, "({x}, {y}): {one}");
+                eprintln!("({x}, {y}) camera at {}: R = {one:.4}", v.center());
+                assert!(one > 0.9 * r && one < 1.6 * r, "({x}, {y}): {one}");
                 support.push((v, [px.x, px.y], b[2] - b[0]));
             }
             let all = cylinder_radius(&head, &support);
-            assert!((all - r).abs() / r < 0.12, "({x}, {y}): {all}");
+            eprintln!("({x}, {y}) mean over cameras: R = {all:.4}");
+            assert!(all > 0.95 * r && all < 1.3 * r, "({x}, {y}): {all}");
         }
     }
 
@@ -797,7 +843,16 @@ mod tests {
             }
             if k >= 10 {
                 assert_eq!(cyl.len(), 2, "frame {k}: {cyl:?}");
-                for (c, p) in cyl.iter().zip(&people) {
+                for p in &people {
+                    // ids follow promotion order, not the people's order: nearest cylinder
+                    let c = cyl
+                        .iter()
+                        .min_by(|a, b| {
+                            let da = (a.x_m - p.1).hypot(a.y_m - p.2);
+                            let db = (b.x_m - p.1).hypot(b.y_m - p.2);
+                            da.total_cmp(&db)
+                        })
+                        .expect("two cylinders");
                     assert!((c.x_m - p.1).hypot(c.y_m - p.2) < 0.05, "{c:?}");
                     assert!((c.height_m - p.3).abs() < 0.02);
                     assert_eq!(c.support.len(), 4, "all four cameras support");
@@ -830,7 +885,9 @@ mod tests {
     #[test]
     fn corrected_error_prefers_more_cameras_and_mean_error_does_not() {
         // every head a few pixels off: subsets of fewer cameras fit better (lower E_m), but
-        // E_c = E_m / 10^N_c still picks all four
+        // E_c = E_m / 10^N_c still picks all four, one person, one object. Choosing by E_m
+        // takes the best-fitting pair instead, and the other two views then form a second
+        // object of their own: the same person counted twice (the paper's reason for E_c).
         let views = office_views(false);
         let mut objs = objects_for(&views, &[(1, 4.0, 4.0, 1.8, 0.2)]);
         for (o, (dx, dy)) in objs.iter_mut().zip([(2.0, 0.0), (0.0, -2.0), (0.0, 1.5), (3.0, 0.0)]) {
@@ -845,11 +902,10 @@ mod tests {
             };
             let mut t = CylinderTracker::new(views.clone(), params).expect("tracker");
             let (cyl, _) = t.step(&objs);
-            assert_eq!(cyl.len(), 1);
-            let n = cyl[0].support.len();
+            let sizes: Vec<usize> = cyl.iter().map(|c| c.support.len()).collect();
             match sel {
-                Selection::Corrected => assert_eq!(n, 4),
-                Selection::Mean => assert!(n < 4, "{n}"),
+                Selection::Corrected => assert_eq!(sizes, vec![4]),
+                Selection::Mean => assert_eq!(sizes, vec![2, 2], "{cyl:?}"),
             }
         }
     }

@@ -474,9 +474,17 @@ mod tests {
         assert!((s.body_width_px - 24.0).abs() <= 1.0, "{}", s.body_width_px);
         // upright: head at the middle column
         assert!((s.head.0 - f64::from(s.width) / 2.0).abs() <= 1.0);
-        // filled fraction of the window about a half
+        // filled fraction of the window: the profile's mean width over its widest (the
+        // shoulders, 2 · 0.12): head half-ellipse 0.13 · (π/4) · 0.052, neck 0.02 · 0.035,
+        // shoulder ramp 0.05 · 0.0775, torso 0.3 · 0.1125, legs 0.5 · 0.09
+        let closed = (0.13 * std::f64::consts::FRAC_PI_4 * 0.052
+            + 0.02 * 0.035
+            + 0.05 * 0.0775
+            + 0.3 * 0.1125
+            + 0.5 * 0.09)
+            / 0.12;
         let fill = f64::from(s.area) / f64::from(s.width * s.height);
-        assert!((0.4..0.7).contains(&fill), "{fill}");
+        assert!((fill - closed).abs() < 0.02, "{fill} vs {closed}");
         // a tilted one puts the head to the right of the feet
         let t = Silhouette::new(100.0, 0.2);
         let feet = t.spans.last().map(|(a, b)| f64::from(a + b) / 2.0).unwrap_or(0.0);
