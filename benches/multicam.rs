@@ -106,7 +106,9 @@ fn bench(c: &mut Criterion) {
     let mut k = 0usize;
     g.bench_function("352x288_frame", |b| {
         b.iter(|| {
-            let s = model.apply(&frames[k % frames.len()], &mut mask).expect("apply");
+            let s = model
+                .apply(&frames[k % frames.len()], &mut mask)
+                .expect("apply");
             k += 1;
             s.foreground
         })
@@ -139,14 +141,9 @@ fn bench(c: &mut Criterion) {
                 log: SessionLog::open(&path).expect("open"),
                 info: info.clone(),
             };
-            MulticamCylinders::process(
-                &s,
-                &p,
-                &BTreeMap::new(),
-                &indicatif::ProgressBar::hidden(),
-            )
-            .expect("process")
-            .len()
+            MulticamCylinders::process(&s, &p, &BTreeMap::new(), &indicatif::ProgressBar::hidden())
+                .expect("process")
+                .len()
         })
     });
     g.finish();

@@ -31,7 +31,10 @@ fn short_scenario(dir: &Path) -> PathBuf {
     let text = std::fs::read_to_string(root().join("datasets/multicam_office/scenario.toml"))
         .expect("scenario");
     let quick = "[profiles.quick]\nsessions = 2\nduration_s = 12.0\n";
-    assert!(text.contains(quick), "the quick profile changed: update this test");
+    assert!(
+        text.contains(quick),
+        "the quick profile changed: update this test"
+    );
     let text = text.replace(quick, "[profiles.quick]\nsessions = 1\nduration_s = 6.0\n");
     let d = dir.join("multicam_office");
     std::fs::create_dir_all(&d).expect("mkdir");
@@ -123,20 +126,20 @@ fn fixture() -> &'static Fixture {
     static F: OnceLock<Fixture> = OnceLock::new();
     F.get_or_init(|| {
         let dir = tempfile::tempdir().expect("tempdir");
-        let root = dir.path().to_path_buf();
-        let scenario = short_scenario(&root.join("synth"));
+        let base = dir.path().to_path_buf();
+        let scenario = short_scenario(&base.join("synth"));
         let s = synthesize(
             &scenario,
             &SynthOptions {
                 profile: "quick".into(),
-                out: Some(root.join("synth/multicam_office")),
+                out: Some(base.join("synth/multicam_office")),
                 preview_root: None,
                 progress: false,
             },
         )
         .expect("synthesizes");
         assert_eq!(s.sessions.len(), 1);
-        let byod = root.join("byod/multicam_office");
+        let byod = base.join("byod/multicam_office");
         std::fs::create_dir_all(&byod).expect("mkdir");
         for p in &s.sessions {
             with_gt_detections(p, &byod.join(p.file_name().expect("name")), None);
@@ -147,12 +150,12 @@ fn fixture() -> &'static Fixture {
             .replace("detector = \"templates\"", "detector = \"log\"")
             .replace("gt_boxes = true", "gt_boxes = false");
         assert!(text.contains("detector = \"log\"") && text.contains("gt_boxes = false"));
-        let pipeline = root.join("multicam_cylinders.toml");
+        let pipeline = base.join("multicam_cylinders.toml");
         std::fs::write(&pipeline, text).expect("pipeline");
         Fixture {
             sessions: format!("{}/*.mcap", byod.display()),
             _dir: dir,
-            root,
+            root: base,
             pipeline,
         }
     })
@@ -246,8 +249,8 @@ fn ground_truth_boxes_through_the_log_detector_path_reach_mota_095_and_tracks_re
     let arrays: Vec<(Nanos, MarkerArray)> = read_topic::<MarkerArray>(&log, "/tracks/cylinders")
         .expect("topic")
         .map(|r| {
-            let (m, a) = r.expect("decodes");
-            (m.log_time, a)
+            let (t, a) = r.expect("decodes");
+            (t, a)
         })
         .collect();
     assert!(arrays.len() > 100, "{} marker messages", arrays.len());
@@ -264,8 +267,14 @@ fn ground_truth_boxes_through_the_log_detector_path_reach_mota_095_and_tracks_re
         assert!(m.pose.position.x > -1.0 && m.pose.position.x < 9.0, "{m:?}");
     }
     // everything else of the input is still there
-    let input = SessionLog::open(glob::glob(&f.sessions).expect("glob").next().expect("one").expect("path"))
-        .expect("input");
+    let input = SessionLog::open(
+        glob::glob(&f.sessions)
+            .expect("glob")
+            .next()
+            .expect("one")
+            .expect("path"),
+    )
+    .expect("input");
     for ch in input.summary().channels.values() {
         assert!(
             log.summary().channel(&ch.topic).is_some(),
@@ -293,7 +302,11 @@ fn a_log_without_one_cameras_calibration_is_skipped_with_file_and_topic() {
     let f = fixture();
     let bad_dir = f.root.join("bad/multicam_office");
     std::fs::create_dir_all(&bad_dir).expect("mkdir");
-    let good = glob::glob(&f.sessions).expect("glob").next().expect("one").expect("path");
+    let good = glob::glob(&f.sessions)
+        .expect("glob")
+        .next()
+        .expect("one")
+        .expect("path");
     // re-derive from the detection log: drop cam_2's CameraInfo
     let bad = bad_dir.join("no_cam2_info.mcap");
     let log = SessionLog::open(&good).expect("open");
@@ -307,7 +320,11 @@ fn a_log_without_one_cameras_calibration_is_skipped_with_file_and_topic() {
             .schema
             .as_deref()
             .map(|s| (s.name.as_str(), s.encoding.as_str(), s.data.as_slice()));
-        channels.insert(*id, w.add_raw(&ch.topic, schema, &ch.message_encoding).expect("ch"));
+        channels.insert(
+            *id,
+            w.add_raw(&ch.topic, schema, &ch.message_encoding)
+                .expect("ch"),
+        );
     }
     for m in log.messages().expect("messages") {
         let m = m.expect("message");
@@ -316,14 +333,27 @@ fn a_log_without_one_cameras_calibration_is_skipped_with_file_and_topic() {
         }
     }
     w.finish().expect("finish");
+    // alone: the run fails, naming the session and the topic
     let out = f.root.join("bad_out");
+    let o = run(f, &out, &format!("{}/*.mcap", bad_dir.display()), &[], &[]);
+    let text = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(text.contains("no_cam2_info"), "{text}");
+    assert!(text.contains("/cam_2/camera_info"), "{text}");
+    assert!(!text.contains("panicked"), "{text}");
+    // beside a good log: the good one is processed, the bad one skipped and reported
+    std::fs::copy(&good, bad_dir.join("good.mcap")).expect("copy");
+    let out = f.root.join("bad_out2");
     let o = run(f, &out, &format!("{}/*.mcap", bad_dir.display()), &[], &[]);
     let text = format!(
         "{}{}",
         String::from_utf8_lossy(&o.stdout),
         String::from_utf8_lossy(&o.stderr)
     );
-    assert!(text.contains("no_cam2_info.mcap"), "{text}");
+    assert!(o.status.success(), "{text}");
+    assert!(text.contains("1 computed"), "{text}");
+    assert!(text.contains("1 skipped"), "{text}");
+    assert!(text.contains("no_cam2_info"), "{text}");
     assert!(text.contains("/cam_2/camera_info"), "{text}");
     assert!(!text.contains("panicked"), "{text}");
 }

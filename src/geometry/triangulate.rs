@@ -131,7 +131,11 @@ pub fn triangulate_rays(
     // on the mean ray origin and scale it to unit mean distance, X = s·X' + m.
     let n = rays.len() as f64;
     let mean = rays.iter().fold(Vector3::zeros(), |a, (o, _)| a + o.coords) / n;
-    let spread = rays.iter().map(|(o, _)| (o.coords - mean).norm()).sum::<f64>() / n;
+    let spread = rays
+        .iter()
+        .map(|(o, _)| (o.coords - mean).norm())
+        .sum::<f64>()
+        / n;
     let scale = if spread > 1e-12 { spread } else { 1.0 };
     // X is the right singular vector of the stacked 3k × 4 system A with the smallest
     // singular value, i.e. the eigenvector of the 4 × 4 AᵀA with the smallest eigenvalue:
@@ -142,7 +146,9 @@ pub fn triangulate_rays(
         let cross = Matrix3::new(0.0, -d.z, d.y, d.z, 0.0, -d.x, -d.y, d.x, 0.0);
         let rhs = cross * (mean - origin.coords);
         let mut block = Matrix3x4::<f64>::zeros();
-        block.fixed_view_mut::<3, 3>(0, 0).copy_from(&(cross * scale));
+        block
+            .fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&(cross * scale));
         block.set_column(3, &rhs);
         ata += block.transpose() * block;
     }
@@ -281,10 +287,7 @@ mod tests {
         let views = corner_views(false);
         let p = Point3::new(4.0, 4.0, 1.7);
         let obs = [(&views[0], views[0].project(&p).expect("visible"))];
-        assert_eq!(
-            triangulate_dlt(&obs),
-            Err(TriangulateError::TooFewViews(1))
-        );
+        assert_eq!(triangulate_dlt(&obs), Err(TriangulateError::TooFewViews(1)));
     }
 
     #[test]

@@ -131,7 +131,10 @@ const DEFINITIONS: &[(&str, &str)] = &[
         "vision_msgs/msg/Detection2DArray",
         "std_msgs/Header header\nDetection2D[] detections\n",
     ),
-    ("std_msgs/msg/ColorRGBA", "float32 r\nfloat32 g\nfloat32 b\nfloat32 a\n"),
+    (
+        "std_msgs/msg/ColorRGBA",
+        "float32 r\nfloat32 g\nfloat32 b\nfloat32 a\n",
+    ),
     (
         "visualization_msgs/msg/Marker",
         "int32 ARROW=0\nint32 CUBE=1\nint32 SPHERE=2\nint32 CYLINDER=3\nint32 LINE_STRIP=4\n\
@@ -143,10 +146,7 @@ const DEFINITIONS: &[(&str, &str)] = &[
          geometry_msgs/Point[] points\nstd_msgs/ColorRGBA[] colors\nstring text\n\
          string mesh_resource\nbool mesh_use_embedded_materials\n",
     ),
-    (
-        "visualization_msgs/msg/MarkerArray",
-        "Marker[] markers\n",
-    ),
+    ("visualization_msgs/msg/MarkerArray", "Marker[] markers\n"),
 ];
 
 const SEPARATOR: &str =

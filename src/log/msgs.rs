@@ -895,7 +895,12 @@ impl RosMessage for Marker {
             ("frame_locked", Value::Bool(self.frame_locked)),
             (
                 "points",
-                Value::Array(self.points.iter().map(|p| xyz_value(p.x, p.y, p.z)).collect()),
+                Value::Array(
+                    self.points
+                        .iter()
+                        .map(|p| xyz_value(p.x, p.y, p.z))
+                        .collect(),
+                ),
             ),
             (
                 "colors",
@@ -1003,7 +1008,10 @@ mod tests {
                     kind: Marker::CYLINDER,
                     scale: Vector3::new(0.4, 0.4, 1.8),
                     color: [0.0, 0.5, 1.0, 0.6],
-                    lifetime: Time { sec: 0, nanosec: 80_000_000 },
+                    lifetime: Time {
+                        sec: 0,
+                        nanosec: 80_000_000,
+                    },
                     ..Default::default()
                 },
                 Marker {

@@ -187,34 +187,70 @@ impl Experiment for MulticamCylinders {
         let mut out: Vec<Invalid> = Vec::new();
         let mut bad = |k: &str, r: String| out.push((k.to_string(), r));
         if p.cameras.len() < 2 {
-            bad("cameras", format!("{} camera(s): triangulation needs at least 2", p.cameras.len()));
+            bad(
+                "cameras",
+                format!(
+                    "{} camera(s): triangulation needs at least 2",
+                    p.cameras.len()
+                ),
+            );
         }
         if !(p.alpha > 0.0 && p.alpha < 1.0) {
-            bad("alpha", format!("{} is not in (0, 1) (paper: 0.01–0.1)", p.alpha));
+            bad(
+                "alpha",
+                format!("{} is not in (0, 1) (paper: 0.01–0.1)", p.alpha),
+            );
         }
         if !(p.gabor_sigma_px >= 0.5 && p.gabor_sigma_px <= 20.0) {
-            bad("gabor_sigma_px", format!("{} is not in [0.5, 20] px", p.gabor_sigma_px));
+            bad(
+                "gabor_sigma_px",
+                format!("{} is not in [0.5, 20] px", p.gabor_sigma_px),
+            );
         }
         if !(p.gabor_wavelength_px >= 2.0 && p.gabor_wavelength_px.is_finite()) {
-            bad("gabor_wavelength_px", format!("{} is below 2 px", p.gabor_wavelength_px));
+            bad(
+                "gabor_wavelength_px",
+                format!("{} is below 2 px", p.gabor_wavelength_px),
+            );
         }
         if !(p.mad_k >= 0.0 && p.mad_k.is_finite()) {
             bad("mad_k", format!("{} is not a finite number ≥ 0", p.mad_k));
         }
         if !(p.template_threshold > 0.0 && p.template_threshold < 1.0) {
-            bad("template_threshold", format!("{} is not in (0, 1) (paper: 0.6–0.75)", p.template_threshold));
+            bad(
+                "template_threshold",
+                format!(
+                    "{} is not in (0, 1) (paper: 0.6–0.75)",
+                    p.template_threshold
+                ),
+            );
         }
-        if p.template_scales == 0 || p.template_tilts == 0 || p.template_scales * p.template_tilts > 64 {
-            bad("template_scales", "scales × tilts must be between 1 and 64".into());
+        if p.template_scales == 0
+            || p.template_tilts == 0
+            || p.template_scales * p.template_tilts > 64
+        {
+            bad(
+                "template_scales",
+                "scales × tilts must be between 1 and 64".into(),
+            );
         }
         if p.template_stride_px == 0 || p.template_stride_px > 16 {
-            bad("template_stride_px", format!("{} is not in 1..=16", p.template_stride_px));
+            bad(
+                "template_stride_px",
+                format!("{} is not in 1..=16", p.template_stride_px),
+            );
         }
         if !(p.person_height_m > 0.5 && p.person_height_m < 2.5) {
-            bad("person_height_m", format!("{} is not a person's height in metres", p.person_height_m));
+            bad(
+                "person_height_m",
+                format!("{} is not a person's height in metres", p.person_height_m),
+            );
         }
         if !(p.p_th_px > 0.0 && p.p_th_px.is_finite()) {
-            bad("p_th_px", format!("{} is not a positive number of pixels", p.p_th_px));
+            bad(
+                "p_th_px",
+                format!("{} is not a positive number of pixels", p.p_th_px),
+            );
         }
         if p.n_app == 0 || p.n_dis == 0 {
             bad("n_app", "N_app and N_dis must be at least 1 frame".into());
@@ -229,13 +265,22 @@ impl Experiment for MulticamCylinders {
             bad("head_height_m", "the range is empty".into());
         }
         if !(p.room_m[0] < p.room_m[2] && p.room_m[1] < p.room_m[3]) {
-            bad("room_m", "needs [x0, y0, x1, y1] with x0 < x1 and y0 < y1".into());
+            bad(
+                "room_m",
+                "needs [x0, y0, x1, y1] with x0 < x1 and y0 < y1".into(),
+            );
         }
         if !(p.sync_tolerance_s > 0.0 && p.sync_tolerance_s < 1.0) {
-            bad("sync_tolerance_s", format!("{} is not in (0, 1) s", p.sync_tolerance_s));
+            bad(
+                "sync_tolerance_s",
+                format!("{} is not in (0, 1) s", p.sync_tolerance_s),
+            );
         }
         if !(0.0..=1.0).contains(&p.occluded_visibility) {
-            bad("occluded_visibility", format!("{} is not in [0, 1]", p.occluded_visibility));
+            bad(
+                "occluded_visibility",
+                format!("{} is not in [0, 1]", p.occluded_visibility),
+            );
         }
         out
     }

@@ -436,9 +436,12 @@ pub fn run_experiment<E: Experiment>(
     }
     if done.is_empty() {
         anyhow::bail!(
-            "{}: every session was skipped; first reason: {}",
+            "{}: every session was skipped; first: {}",
             path.display(),
-            summary.skipped.first().map_or("", |s| s.1.as_str())
+            summary
+                .skipped
+                .first()
+                .map_or(String::new(), |s| format!("{}: {}", s.0, s.1))
         );
     }
     let products = E::aggregate(

@@ -136,9 +136,13 @@ impl Default for CylinderParams {
 
 impl CylinderParams {
     pub fn validate(&self) -> Result<(), CylinderError> {
-        let bad = |name: &'static str, reason: String| Err(CylinderError::BadParameter { name, reason });
+        let bad =
+            |name: &'static str, reason: String| Err(CylinderError::BadParameter { name, reason });
         if !(self.p_th_px.is_finite() && self.p_th_px > 0.0) {
-            return bad("p_th_px", format!("{} is not a positive number of pixels", self.p_th_px));
+            return bad(
+                "p_th_px",
+                format!("{} is not a positive number of pixels", self.p_th_px),
+            );
         }
         if self.n_app == 0 || self.n_dis == 0 {
             return bad("n_app/n_dis", "must be at least 1 frame".into());
@@ -339,8 +343,10 @@ impl CylinderTracker {
         if combo.len() < p.min_cameras {
             return None;
         }
-        let rays: Vec<(Point3<f64>, nalgebra::Vector3<f64>)> =
-            combo.iter().map(|&i| (prepared[i].origin, prepared[i].dir)).collect();
+        let rays: Vec<(Point3<f64>, nalgebra::Vector3<f64>)> = combo
+            .iter()
+            .map(|&i| (prepared[i].origin, prepared[i].dir))
+            .collect();
         let head = triangulate_rays(&rays).ok()?;
         let room = p.room_m;
         let m = p.room_margin_m;
@@ -371,10 +377,19 @@ impl CylinderTracker {
         }
         let support3: Vec<(&CalibratedView, [f64; 2], f64)> = combo
             .iter()
-            .map(|&i| (&self.views[prepared[i].camera], prepared[i].head_px, prepared[i].width_px))
+            .map(|&i| {
+                (
+                    &self.views[prepared[i].camera],
+                    prepared[i].head_px,
+                    prepared[i].width_px,
+                )
+            })
             .collect();
         Some(Hypothesis {
-            support: combo.iter().map(|&i| (prepared[i].camera, prepared[i].id)).collect(),
+            support: combo
+                .iter()
+                .map(|&i| (prepared[i].camera, prepared[i].id))
+                .collect(),
             head_m: head,
             e_m_px: e_m,
             e_c: e_m.max(E_M_FLOOR_PX) / 10f64.powi(n as i32),
@@ -436,7 +451,12 @@ impl CylinderTracker {
 
     /// All combinations (as sorted index lists) of `free` objects, at most one per camera and
     /// at least `min_cameras`; pairwise-coherent ones only when there would be too many.
-    fn combinations(&self, prepared: &[Prepared], free: &[usize], stats: &mut StepStats) -> Vec<Vec<usize>> {
+    fn combinations(
+        &self,
+        prepared: &[Prepared],
+        free: &[usize],
+        stats: &mut StepStats,
+    ) -> Vec<Vec<usize>> {
         let n_cams = self.views.len();
         let mut per_cam: Vec<Vec<usize>> = vec![Vec::new(); n_cams];
         for &i in free {
@@ -678,7 +698,11 @@ impl CylinderTracker {
                 vy_mps: o.kf.x[3],
                 height_m: o.kf.x[4],
                 radius_m: o.kf.x[5],
-                support: if o.measured.is_some() { o.support.clone() } else { Vec::new() },
+                support: if o.measured.is_some() {
+                    o.support.clone()
+                } else {
+                    Vec::new()
+                },
                 measured: o.measured.clone(),
                 age: o.age,
             })
@@ -716,8 +740,19 @@ mod tests {
     }
 
     /// Image box of a vertical cylinder (sampled rims and sides), raw pixels.
-    pub(crate) fn cylinder_box(view: &CalibratedView, x: f64, y: f64, h: f64, r: f64) -> Option<[f64; 4]> {
-        let mut b = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+    pub(crate) fn cylinder_box(
+        view: &CalibratedView,
+        x: f64,
+        y: f64,
+        h: f64,
+        r: f64,
+    ) -> Option<[f64; 4]> {
+        let mut b = [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        ];
         for k in 0..=40 {
             let z = h * f64::from(k) / 40.0;
             for a in 0..72 {
@@ -729,7 +764,10 @@ mod tests {
         Some(b)
     }
 
-    fn objects_for(views: &[CalibratedView], people: &[(u32, f64, f64, f64, f64)]) -> Vec<Object2d> {
+    fn objects_for(
+        views: &[CalibratedView],
+        people: &[(u32, f64, f64, f64, f64)],
+    ) -> Vec<Object2d> {
         let mut out = Vec::new();
         for (c, v) in views.iter().enumerate() {
             for &(id, x, y, h, r) in people {
@@ -796,7 +834,10 @@ mod tests {
                 let got = cylinder_radius(&head, &[(&view, [px.x, px.y], hi - lo)]);
                 let delta = (r / d).asin();
                 let closed = 0.5 * ((a + delta).tan() - (a - delta).tan()) * a.cos().powi(2) * d;
-                assert!((got - closed).abs() < 1e-6, "D {d} α {alpha_deg}: {got} vs {closed}");
+                assert!(
+                    (got - closed).abs() < 1e-6,
+                    "D {d} α {alpha_deg}: {got} vs {closed}"
+                );
                 assert!((got - r).abs() / r < 0.01, "D {d} α {alpha_deg}: {got}");
             }
         }
@@ -890,7 +931,10 @@ mod tests {
         // object of their own: the same person counted twice (the paper's reason for E_c).
         let views = office_views(false);
         let mut objs = objects_for(&views, &[(1, 4.0, 4.0, 1.8, 0.2)]);
-        for (o, (dx, dy)) in objs.iter_mut().zip([(2.0, 0.0), (0.0, -2.0), (0.0, 1.5), (3.0, 0.0)]) {
+        for (o, (dx, dy)) in objs
+            .iter_mut()
+            .zip([(2.0, 0.0), (0.0, -2.0), (0.0, 1.5), (3.0, 0.0)])
+        {
             o.head_px[0] += dx;
             o.head_px[1] += dy;
         }
@@ -914,7 +958,10 @@ mod tests {
     fn support_difference_counts_cameras() {
         assert_eq!(support_difference(&[(0, 1), (1, 2)], &[(0, 1), (1, 2)]), 0);
         assert_eq!(support_difference(&[(0, 1), (1, 2)], &[(0, 1), (1, 3)]), 1);
-        assert_eq!(support_difference(&[(0, 1), (1, 2)], &[(0, 1), (1, 2), (2, 7)]), 1);
+        assert_eq!(
+            support_difference(&[(0, 1), (1, 2)], &[(0, 1), (1, 2), (2, 7)]),
+            1
+        );
         assert_eq!(support_difference(&[(0, 1), (1, 2)], &[(0, 1), (2, 7)]), 2);
     }
 }

@@ -143,7 +143,12 @@ impl GraphTracker {
                 t.head.predict(&f, &q);
                 t.size.predict(&Matrix2::identity(), &q_size);
                 let (dx, dy) = (t.head.x[0] - t.bbox_head[0], t.head.x[1] - t.bbox_head[1]);
-                [t.bbox[0] + dx, t.bbox[1] + dy, t.bbox[2] + dx, t.bbox[3] + dy]
+                [
+                    t.bbox[0] + dx,
+                    t.bbox[1] + dy,
+                    t.bbox[2] + dx,
+                    t.bbox[3] + dy,
+                ]
             })
             .collect();
         let pairs = max_score_pairs(predicted.len(), detections.len(), |i, j| {
@@ -161,9 +166,9 @@ impl GraphTracker {
             matched_det[j] = true;
             let d = &detections[j];
             let t = &mut self.tracks[i];
-            let ok_head = t
-                .head
-                .update(&h_head, &r_head, &Vector2::new(d.head_px[0], d.head_px[1]));
+            let ok_head =
+                t.head
+                    .update(&h_head, &r_head, &Vector2::new(d.head_px[0], d.head_px[1]));
             let ok_size = t.size.update(
                 &Matrix2::identity(),
                 &r_size,

@@ -59,7 +59,10 @@ impl<const N: usize> Kalman<N> {
 
 /// Constant-velocity model for state `[x, y, vx, vy]`: transition `F` and process noise `Q`
 /// of a white-noise acceleration with standard deviation `accel_sigma` (units/s²).
-pub fn constant_velocity_2d(dt_s: f64, accel_sigma: f64) -> (SMatrix<f64, 4, 4>, SMatrix<f64, 4, 4>) {
+pub fn constant_velocity_2d(
+    dt_s: f64,
+    accel_sigma: f64,
+) -> (SMatrix<f64, 4, 4>, SMatrix<f64, 4, 4>) {
     let mut f = SMatrix::<f64, 4, 4>::identity();
     f[(0, 2)] = dt_s;
     f[(1, 3)] = dt_s;
@@ -81,8 +84,7 @@ mod tests {
     use nalgebra::{Matrix1, Matrix2x4, Vector1, Vector2, Vector4};
 
     fn is_psd_symmetric(p: &SMatrix<f64, 4, 4>) -> bool {
-        (p - p.transpose()).norm() < 1e-12
-            && p.symmetric_eigenvalues().iter().all(|&e| e > -1e-12)
+        (p - p.transpose()).norm() < 1e-12 && p.symmetric_eigenvalues().iter().all(|&e| e > -1e-12)
     }
 
     #[test]

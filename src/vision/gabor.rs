@@ -619,9 +619,17 @@ mod tests {
             );
         };
         // median 3, |v − 3| = [2, 1, 0, 1, 97] → MAD 1
-        check(&[1.0, 2.0, 3.0, 4.0, 100.0], 3.0, (3.0 + 3.0 * MAD_TO_SIGMA, 3.0, 1.0));
+        check(
+            &[1.0, 2.0, 3.0, 4.0, 100.0],
+            3.0,
+            (3.0 + 3.0 * MAD_TO_SIGMA, 3.0, 1.0),
+        );
         // even count: median (2 + 4) / 2 = 3, |v − 3| = [2, 1, 1, 5] → MAD 1.5
-        check(&[8.0, 1.0, 4.0, 2.0], 2.0, (3.0 + 2.0 * MAD_TO_SIGMA * 1.5, 3.0, 1.5));
+        check(
+            &[8.0, 1.0, 4.0, 2.0],
+            2.0,
+            (3.0 + 2.0 * MAD_TO_SIGMA * 1.5, 3.0, 1.5),
+        );
         // constant sample: MAD 0, threshold = median
         check(&[0.5; 7], 3.0, (0.5, 0.5, 0.0));
         assert!(mad_threshold(&[], 3.0).is_none());

@@ -313,7 +313,10 @@ fn score_at(
 ) -> Option<f64> {
     let (w, h) = (sums.w as i64, sums.h as i64);
     let (x0, y0) = (x.max(0), y.max(0));
-    let (x1, y1) = ((x + i64::from(t.width)).min(w), (y + i64::from(t.height)).min(h));
+    let (x1, y1) = (
+        (x + i64::from(t.width)).min(w),
+        (y + i64::from(t.height)).min(h),
+    );
     if x1 <= x0 || y1 <= y0 || y < 0 || y >= h {
         return None;
     }
@@ -323,7 +326,8 @@ fn score_at(
         return None;
     }
     let sw = f64::from(sums.window(x0 as usize, y0 as usize, x1 as usize, y1 as usize));
-    let inside = x0 == x && y0 == y && x1 == x + i64::from(t.width) && y1 == y + i64::from(t.height);
+    let inside =
+        x0 == x && y0 == y && x1 == x + i64::from(t.width) && y1 == y + i64::from(t.height);
     if inside && 1.0 - (f64::from(t.area) - sw).abs() / area < threshold {
         return None; // cannot reach the threshold whatever the overlap
     }
@@ -336,7 +340,10 @@ fn score_at(
         if yy >= h {
             break;
         }
-        let (a, b) = ((x + i64::from(a)).clamp(0, w), (x + i64::from(b)).clamp(0, w));
+        let (a, b) = (
+            (x + i64::from(a)).clamp(0, w),
+            (x + i64::from(b)).clamp(0, w),
+        );
         if b > a {
             t1 += (b - a) as u32;
             c += sums.row(yy as usize, a as usize, b as usize);
@@ -391,8 +398,10 @@ pub fn detect(mask: &Mask, templates: &[Silhouette], p: &DetectorParams) -> Vec<
             let _ = th;
         }
     }
-    let mut cands: Vec<(f64, i64, i64, usize)> =
-        best.into_iter().map(|((x, y), (s, t))| (s, y, x, t)).collect();
+    let mut cands: Vec<(f64, i64, i64, usize)> = best
+        .into_iter()
+        .map(|((x, y), (s, t))| (s, y, x, t))
+        .collect();
     // best first; ties broken by position and template for determinism
     cands.sort_by(|a, b| {
         b.0.total_cmp(&a.0)
@@ -487,7 +496,11 @@ mod tests {
         assert!((fill - closed).abs() < 0.02, "{fill} vs {closed}");
         // a tilted one puts the head to the right of the feet
         let t = Silhouette::new(100.0, 0.2);
-        let feet = t.spans.last().map(|(a, b)| f64::from(a + b) / 2.0).unwrap_or(0.0);
+        let feet = t
+            .spans
+            .last()
+            .map(|(a, b)| f64::from(a + b) / 2.0)
+            .unwrap_or(0.0);
         assert!(t.head.0 > feet + 10.0);
     }
 
@@ -547,7 +560,11 @@ mod tests {
         }
         let dets = detect(&mask, std::slice::from_ref(&t), &DetectorParams::default());
         assert_eq!(dets.len(), 1);
-        assert!(dets[0].score > 0.7 && dets[0].score < 0.9, "{}", dets[0].score);
+        assert!(
+            dets[0].score > 0.7 && dets[0].score < 0.9,
+            "{}",
+            dets[0].score
+        );
         // the blob centroid moved up, the head did not
         assert!(dets[0].centroid_px[1] < 10.0 + 0.35 * 80.0);
         assert!((dets[0].head_px[1] - 10.0).abs() <= 2.0);

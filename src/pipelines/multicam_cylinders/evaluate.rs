@@ -12,7 +12,9 @@ use polars::prelude::*;
 
 use super::Params;
 use super::session::{GT_BOXES, main_detector, selection_label};
-use crate::eval::mot::{Evaluation, EventKind, GroundPoint, Geometry, MatchRule, Observation, evaluate};
+use crate::eval::mot::{
+    Evaluation, EventKind, Geometry, GroundPoint, MatchRule, Observation, evaluate,
+};
 use crate::eval::stats::{DEFAULT_LEVEL, describe, student_t};
 use crate::report::Table;
 use crate::run::{Aggregate, Products};
@@ -173,9 +175,12 @@ fn load(ctx: &Aggregate) -> anyhow::Result<Vec<SessionData>> {
     let mut out = Vec::new();
     for (info, frames) in ctx.sessions {
         let get = |n: &str| {
-            frames
-                .get(n)
-                .with_context(|| format!("{}/{}: cached result lacks the {n} table", info.dataset, info.name))
+            frames.get(n).with_context(|| {
+                format!(
+                    "{}/{}: cached result lacks the {n} table",
+                    info.dataset, info.name
+                )
+            })
         };
         let session = get("session")?;
         out.push(SessionData {
@@ -191,8 +196,14 @@ fn load(ctx: &Aggregate) -> anyhow::Result<Vec<SessionData>> {
             dt_s: f64s(session, "dt_s")?.first().copied().unwrap_or(0.04),
             duration_s: f64s(session, "duration_s")?.first().copied().unwrap_or(0.0),
             frames: i64s(session, "frames")?.first().copied().unwrap_or(0),
-            decode_failures: i64s(session, "decode_failures")?.first().copied().unwrap_or(0),
-            first_error: strs(session, "first_error")?.first().cloned().unwrap_or_default(),
+            decode_failures: i64s(session, "decode_failures")?
+                .first()
+                .copied()
+                .unwrap_or(0),
+            first_error: strs(session, "first_error")?
+                .first()
+                .cloned()
+                .unwrap_or_default(),
         });
     }
     Ok(out)
@@ -324,7 +335,11 @@ fn median(v: &[f64]) -> Option<f64> {
     let mut s = v.to_vec();
     s.sort_by(f64::total_cmp);
     let n = s.len();
-    Some(if n % 2 == 1 { s[n / 2] } else { 0.5 * (s[n / 2 - 1] + s[n / 2]) })
+    Some(if n % 2 == 1 {
+        s[n / 2]
+    } else {
+        0.5 * (s[n / 2 - 1] + s[n / 2])
+    })
 }
 
 fn percentile(v: &[f64], q: f64) -> Option<f64> {
@@ -431,22 +446,28 @@ pub(crate) fn aggregate(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products>
         if let Some(t) = gt_boxes_table(&scored, p, &mut products.summary) {
             products.tables.push(t);
         }
-        products.tables.push(position_table(&scored, p, &mut products.summary)?);
+        products
+            .tables
+            .push(position_table(&scored, p, &mut products.summary)?);
         let (sweep, curve) = sweep_table(&scored, p);
         products.tables.push(sweep);
         products.figures.push(curve);
         let (hc, bars) = head_centroid_table(&scored, p, &mut products.summary)?;
         products.tables.push(hc);
         products.figures.extend(bars);
-        products.tables.push(selection_table(&scored, p, &mut products.summary));
+        products
+            .tables
+            .push(selection_table(&scored, p, &mut products.summary));
     } else {
-        products.summary.push(
-            "No ground truth in these logs: tracks only, no accuracy tables.".to_string(),
-        );
+        products
+            .summary
+            .push("No ground truth in these logs: tracks only, no accuracy tables.".to_string());
     }
     products.tables.push(stages_table(&scored)?);
     products.tables.push(search_table(&scored)?);
-    products.figures.extend(super::figures::birdseye(&scored, p));
+    products
+        .figures
+        .extend(super::figures::birdseye(&scored, p));
     match super::figures::camera_views(&scored, p) {
         Ok(Some(f)) => products.figures.push(f),
         Ok(None) => {}
@@ -482,12 +503,36 @@ pub(crate) fn aggregate(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products>
 }
 
 fn tracks_table(s: &Scored) -> Table {
-    let (mut sess, mut id, mut t0, mut t1, mut frames, mut supported) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let (mut mx, mut my, mut mh, mut mr, mut mc, mut me) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut sess, mut id, mut t0, mut t1, mut frames, mut supported) = (
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+    );
+    let (mut mx, mut my, mut mh, mut mr, mut mc, mut me) = (
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+    );
     // per-frame samples
-    let (mut s_sess, mut s_frame, mut s_t, mut s_id, mut s_x, mut s_y, mut s_h, mut s_r, mut s_c, mut s_sup, mut s_e) = (
+    let (
+        mut s_sess,
+        mut s_frame,
+        mut s_t,
+        mut s_id,
+        mut s_x,
+        mut s_y,
+        mut s_h,
+        mut s_r,
+        mut s_c,
+        mut s_sup,
+        mut s_e,
+    ) = (
         Vec::new(),
         Vec::new(),
         Vec::new(),
@@ -570,9 +615,27 @@ fn tracks_table(s: &Scored) -> Table {
 }
 
 fn clear_mot_table(s: &Scored, p: &Params) -> Table {
-    let mut cols: (Vec<String>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) =
-        Default::default();
-    let mut counts: (Vec<i64>, Vec<i64>, Vec<i64>, Vec<i64>, Vec<i64>, Vec<i64>, Vec<i64>, Vec<i64>) = Default::default();
+    let mut cols: (
+        Vec<String>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+    ) = Default::default();
+    let mut counts: (
+        Vec<i64>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<i64>,
+    ) = Default::default();
     let mut paper = Vec::new();
     let detectors: Vec<String> = {
         let mut v: Vec<String> = s.keys.iter().map(|k| k.0.clone()).collect();
@@ -664,7 +727,17 @@ fn position_table(s: &Scored, p: &Params, summary: &mut Vec<String>) -> anyhow::
     let mut det_col = Vec::new();
     let mut sess_col = Vec::new();
     let mut id_col = Vec::new();
-    let (mut n_col, mut ge_mean, mut ge_std, mut ge_p95, mut he_mean, mut he_abs, mut r_est, mut r_true, mut h_true) = (
+    let (
+        mut n_col,
+        mut ge_mean,
+        mut ge_std,
+        mut ge_p95,
+        mut he_mean,
+        mut he_abs,
+        mut r_est,
+        mut r_true,
+        mut h_true,
+    ) = (
         Vec::new(),
         Vec::new(),
         Vec::new(),
@@ -675,13 +748,24 @@ fn position_table(s: &Scored, p: &Params, summary: &mut Vec<String>) -> anyhow::
         Vec::new(),
         Vec::new(),
     );
-    let mut smp: (Vec<String>, Vec<String>, Vec<i64>, Vec<i64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) =
-        Default::default();
+    let mut smp: (
+        Vec<String>,
+        Vec<String>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+    ) = Default::default();
     let mut detectors: Vec<String> = s.keys.iter().map(|k| k.0.clone()).collect();
     detectors.dedup();
     for det in &detectors {
         let key: Key = (det.clone(), s.main.1.clone(), s.main.2);
-        let Some(ev) = s.eval(&key, t_match) else { continue };
+        let Some(ev) = s.eval(&key, t_match) else {
+            continue;
+        };
         // lookups: (global frame, global id) → row
         let mut hyp: HashMap<(i64, i64), (usize, usize)> = HashMap::new();
         let mut gt: HashMap<(i64, i64), (usize, usize)> = HashMap::new();
@@ -700,8 +784,11 @@ fn position_table(s: &Scored, p: &Params, summary: &mut Vec<String>) -> anyhow::
             if !matches!(e.kind, EventKind::Match | EventKind::Switch) {
                 continue;
             }
-            let (Some(g), Some(h)) = (e.gt_id, e.hyp_id) else { continue };
-            let (Some(&(si, gi)), Some(&(_, hi))) = (gt.get(&(e.frame, g)), hyp.get(&(e.frame, h))) else {
+            let (Some(g), Some(h)) = (e.gt_id, e.hyp_id) else {
+                continue;
+            };
+            let (Some(&(si, gi)), Some(&(_, hi))) = (gt.get(&(e.frame, g)), hyp.get(&(e.frame, h)))
+            else {
                 continue;
             };
             let (d, tr) = (&s.data[si].truth, &s.data[si].tracks);
@@ -785,8 +872,19 @@ fn position_table(s: &Scored, p: &Params, summary: &mut Vec<String>) -> anyhow::
 fn sweep_table(s: &Scored, p: &Params) -> (Table, crate::report::Figure) {
     use crate::report::figure::{Event, FigureKind, LinePlot, Mark, Series};
     let t_match = s.thresholds[s.thresholds.len() - 1];
-    let mut c: (Vec<String>, Vec<i64>, Vec<Option<f64>>, Vec<Option<f64>>, Vec<Option<f64>>, Vec<i64>, Vec<i64>, Vec<i64>, Vec<i64>, Vec<f64>, Vec<f64>) =
-        Default::default();
+    let mut c: (
+        Vec<String>,
+        Vec<i64>,
+        Vec<Option<f64>>,
+        Vec<Option<f64>>,
+        Vec<Option<f64>>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<f64>,
+        Vec<f64>,
+    ) = Default::default();
     let mut paper = Vec::new();
     let mut detectors: Vec<String> = s.keys.iter().map(|k| k.0.clone()).collect();
     detectors.dedup();
@@ -807,7 +905,9 @@ fn sweep_table(s: &Scored, p: &Params) -> (Table, crate::report::Figure) {
                 continue;
             }
             let key: Key = (det.clone(), s.main.1.clone(), n);
-            let Some(ev) = s.eval(&key, t_match) else { continue };
+            let Some(ev) = s.eval(&key, t_match) else {
+                continue;
+            };
             let l = latency(&s.data, &key, ev);
             c.0.push(det.clone());
             c.1.push(n);
@@ -831,12 +931,22 @@ fn sweep_table(s: &Scored, p: &Params) -> (Table, crate::report::Figure) {
             fa_pts.push((n as f64, l.false_alarm_tracks as f64));
         }
         series.push(
-            Series::line(format!("{det}: mean latency (frames)"), lat_pts, 2 * di + 1)
-                .with_mark(if di == 0 { Mark::LinePoints } else { Mark::Dashed }),
+            Series::line(format!("{det}: mean latency (frames)"), lat_pts, 2 * di + 1).with_mark(
+                if di == 0 {
+                    Mark::LinePoints
+                } else {
+                    Mark::Dashed
+                },
+            ),
         );
         series.push(
-            Series::line(format!("{det}: false-alarm tracks"), fa_pts, 2 * di + 5)
-                .with_mark(if di == 0 { Mark::LinePoints } else { Mark::Dashed }),
+            Series::line(format!("{det}: false-alarm tracks"), fa_pts, 2 * di + 5).with_mark(
+                if di == 0 {
+                    Mark::LinePoints
+                } else {
+                    Mark::Dashed
+                },
+            ),
         );
     }
     let df = df! {
@@ -880,9 +990,29 @@ fn head_centroid_table(
     summary: &mut Vec<String>,
 ) -> anyhow::Result<(Table, Vec<crate::report::Figure>)> {
     use crate::report::figure::{Bar, BarPlot, FigureKind, Significance};
-    let mut c: (Vec<String>, Vec<String>, Vec<i64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<bool>) =
-        Default::default();
-    let mut smp: (Vec<String>, Vec<String>, Vec<i64>, Vec<i64>, Vec<String>, Vec<f64>, Vec<f64>) = Default::default();
+    let mut c: (
+        Vec<String>,
+        Vec<String>,
+        Vec<i64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<bool>,
+    ) = Default::default();
+    let mut smp: (
+        Vec<String>,
+        Vec<String>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<String>,
+        Vec<f64>,
+        Vec<f64>,
+    ) = Default::default();
     let mut figures = Vec::new();
     let mut detectors: Vec<String> = Vec::new();
     let mut rows: BTreeMap<(String, String), (Vec<f64>, Vec<f64>)> = BTreeMap::new();
@@ -922,7 +1052,9 @@ fn head_centroid_table(
         let mut bars = Vec::new();
         let mut sig = Vec::new();
         for set in ["static occlusion", "unoccluded"] {
-            let Some((h, m)) = rows.get(&(det.clone(), set.to_string())) else { continue };
+            let Some((h, m)) = rows.get(&(det.clone(), set.to_string())) else {
+                continue;
+            };
             let test = student_t(h, m, DEFAULT_LEVEL).ok();
             c.0.push(det.clone());
             c.1.push(set.to_string());
@@ -935,7 +1067,10 @@ fn head_centroid_table(
             c.8.push(test.as_ref().map_or(f64::NAN, |t| t.df));
             c.9.push(test.as_ref().map_or(f64::NAN, |t| t.p_two_sided));
             c.10.push(test.as_ref().map_or(f64::NAN, |t| t.cohens_d));
-            c.11.push(test.as_ref().is_some_and(|t| t.significant(1.0 - DEFAULT_LEVEL)));
+            c.11.push(
+                test.as_ref()
+                    .is_some_and(|t| t.significant(1.0 - DEFAULT_LEVEL)),
+            );
             let i0 = bars.len();
             bars.push(Bar {
                 label: format!("head, {set}"),
@@ -1005,15 +1140,27 @@ fn head_centroid_table(
 }
 
 fn selection_table(s: &Scored, _p: &Params, summary: &mut Vec<String>) -> Table {
-    let mut c: (Vec<String>, Vec<String>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<i64>, Vec<i64>, Vec<i64>, Vec<f64>, Vec<f64>) =
-        Default::default();
+    let mut c: (
+        Vec<String>,
+        Vec<String>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<f64>,
+        Vec<f64>,
+    ) = Default::default();
     let mut detectors: Vec<String> = s.keys.iter().map(|k| k.0.clone()).collect();
     detectors.dedup();
     let (lo, hi) = (s.thresholds[0], s.thresholds[s.thresholds.len() - 1]);
     for det in &detectors {
         for sel in ["E_c", "E_m"] {
             let key: Key = (det.clone(), sel.to_string(), s.main.2);
-            let (Some(a), Some(b)) = (s.eval(&key, lo), s.eval(&key, hi)) else { continue };
+            let (Some(a), Some(b)) = (s.eval(&key, lo), s.eval(&key, hi)) else {
+                continue;
+            };
             let mut cams = Vec::new();
             let mut ems = Vec::new();
             for d in &s.data {
@@ -1084,8 +1231,14 @@ fn stages_table(s: &Scored) -> anyhow::Result<Table> {
             e.4 += 1;
         }
     }
-    let (mut cam, mut fg, mut th, mut de, mut ob, mut n) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut cam, mut fg, mut th, mut de, mut ob, mut n) = (
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+    );
     for (k, v) in acc {
         let m = v.4.max(1) as f64;
         cam.push(k);
@@ -1115,7 +1268,11 @@ fn search_table(s: &Scored) -> anyhow::Result<Table> {
     let mut acc: BTreeMap<(String, String, i64), (i64, i64, i64, i64, i64)> = BTreeMap::new();
     for d in &s.data {
         let v = &d.variants;
-        let (det, sel, n) = (strs(v, "detector")?, strs(v, "selection")?, i64s(v, "n_app")?);
+        let (det, sel, n) = (
+            strs(v, "detector")?,
+            strs(v, "selection")?,
+            i64s(v, "n_app")?,
+        );
         let (c, pr, po, di) = (
             i64s(v, "combinations")?,
             i64s(v, "pruned_frames")?,
@@ -1123,7 +1280,9 @@ fn search_table(s: &Scored) -> anyhow::Result<Table> {
             i64s(v, "discarded")?,
         );
         for i in 0..det.len() {
-            let e = acc.entry((det[i].clone(), sel[i].clone(), n[i])).or_default();
+            let e = acc
+                .entry((det[i].clone(), sel[i].clone(), n[i]))
+                .or_default();
             e.0 += c[i];
             e.1 += pr[i];
             e.2 += po[i];
@@ -1131,7 +1290,15 @@ fn search_table(s: &Scored) -> anyhow::Result<Table> {
             e.4 += d.frames;
         }
     }
-    let mut c: (Vec<String>, Vec<String>, Vec<i64>, Vec<f64>, Vec<i64>, Vec<i64>, Vec<i64>) = Default::default();
+    let mut c: (
+        Vec<String>,
+        Vec<String>,
+        Vec<i64>,
+        Vec<f64>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<i64>,
+    ) = Default::default();
     for ((det, sel, n), v) in acc {
         c.0.push(det);
         c.1.push(sel);

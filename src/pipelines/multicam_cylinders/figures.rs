@@ -10,7 +10,9 @@ use super::{Params, topics};
 use crate::geometry::triangulate::CalibratedView;
 use crate::log::SessionLog;
 use crate::report::Figure;
-use crate::report::figure::{Circle, FigureKind, ImageOverlay, Mark, Overlay, Sensor, Series, TopView};
+use crate::report::figure::{
+    Circle, FigureKind, ImageOverlay, Mark, Overlay, Sensor, Series, TopView,
+};
 use crate::time::Nanos;
 
 fn rect(r: &[f64; 4]) -> Vec<(f64, f64)> {
@@ -36,13 +38,18 @@ pub(super) fn birdseye(s: &Scored, p: &Params) -> Vec<Figure> {
         }
         for (k, (_, pts)) in truth.into_iter().enumerate() {
             trajectories.push(
-                Series::line(if k == 0 { "ground truth" } else { "" }, pts, 0).with_mark(Mark::Dashed),
+                Series::line(if k == 0 { "ground truth" } else { "" }, pts, 0)
+                    .with_mark(Mark::Dashed),
             );
         }
         for (k, (id, ix)) in by_id.iter().enumerate() {
             let color = (*id as usize % 7) + 1;
             trajectories.push(Series::line(
-                if k == 0 { "3-D tracks (cylinders at their last position)" } else { "" },
+                if k == 0 {
+                    "3-D tracks (cylinders at their last position)"
+                } else {
+                    ""
+                },
                 ix.iter().map(|&i| (t.x[i], t.y[i])).collect(),
                 color,
             ));
@@ -74,7 +81,10 @@ pub(super) fn birdseye(s: &Scored, p: &Params) -> Vec<Figure> {
         };
         out.push(Figure::new(
             format!("birdseye_{}", sanitize(&d.name)),
-            format!("Bird's-eye view, {}/{}: 3-D tracks and cylinders", d.dataset, d.name),
+            format!(
+                "Bird's-eye view, {}/{}: 3-D tracks and cylinders",
+                d.dataset, d.name
+            ),
             FigureKind::TopView(TopView {
                 outline: rect(&p.room_m),
                 obstacles: p.figure_obstacles_m.iter().map(rect).collect(),
@@ -171,9 +181,12 @@ pub(super) fn camera_views(s: &Scored, p: &Params) -> anyhow::Result<Option<Figu
         if let Some(img) = img {
             image::imageops::overlay(&mut canvas, img, i64::from(ox), i64::from(oy));
         }
-        let Some(view) = calib.views.get(c) else { continue };
+        let Some(view) = calib.views.get(c) else {
+            continue;
+        };
         let (oxf, oyf) = (f64::from(ox), f64::from(oy));
-        let inside = |q: &(f64, f64)| q.0 >= 0.0 && q.1 >= 0.0 && q.0 < f64::from(w) && q.1 < f64::from(h);
+        let inside =
+            |q: &(f64, f64)| q.0 >= 0.0 && q.1 >= 0.0 && q.0 < f64::from(w) && q.1 < f64::from(h);
         for &i in rows.iter().filter(|&&i| t.frame[i] == frame) {
             let color = (t.id[i] as usize % 7) + 1;
             let r = if t.r[i].is_finite() { t.r[i] } else { 0.2 };
@@ -226,6 +239,12 @@ pub(super) fn camera_views(s: &Scored, p: &Params) -> anyhow::Result<Option<Figu
 
 pub(super) fn sanitize(s: &str) -> String {
     s.chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '_' || c == '-' { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect()
 }

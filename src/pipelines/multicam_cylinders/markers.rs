@@ -24,7 +24,12 @@ use crate::time::Nanos;
 pub(crate) type FrameTracks = (Nanos, Vec<(i64, f64, f64, f64, f64, i64)>);
 
 /// The marker array of one frame.
-pub(crate) fn markers_for(frame_id: &str, stamp: Nanos, life_s: f64, tracks: &[(i64, f64, f64, f64, f64, i64)]) -> MarkerArray {
+pub(crate) fn markers_for(
+    frame_id: &str,
+    stamp: Nanos,
+    life_s: f64,
+    tracks: &[(i64, f64, f64, f64, f64, i64)],
+) -> MarkerArray {
     let lifetime = Time {
         sec: life_s.floor() as i32,
         nanosec: ((life_s.fract()) * 1e9) as u32,
@@ -105,16 +110,28 @@ pub(crate) fn write_tracks(
         let m = m?;
         while next < frames.len() && frames[next].0 <= m.log_time {
             let (stamp, tracks) = &frames[next];
-            w.write(markers, *stamp, &markers_for(frame_id, *stamp, life_s, tracks))?;
+            w.write(
+                markers,
+                *stamp,
+                &markers_for(frame_id, *stamp, life_s, tracks),
+            )?;
             next += 1;
         }
-        let ch = channels
-            .get(&m.channel.id)
-            .with_context(|| format!("{}: channel {} not in the summary", input.display(), m.channel.id))?;
+        let ch = channels.get(&m.channel.id).with_context(|| {
+            format!(
+                "{}: channel {} not in the summary",
+                input.display(),
+                m.channel.id
+            )
+        })?;
         w.write_bytes(*ch, m.log_time, &m.data)?;
     }
     for (stamp, tracks) in &frames[next..] {
-        w.write(markers, *stamp, &markers_for(frame_id, *stamp, life_s, tracks))?;
+        w.write(
+            markers,
+            *stamp,
+            &markers_for(frame_id, *stamp, life_s, tracks),
+        )?;
     }
     w.finish()?;
     Ok(frames.len())
@@ -135,11 +152,22 @@ pub(super) fn write_all(s: &Scored, p: &Params, dir: &Path) -> anyhow::Result<Ve
                 f.1.push((t.id[i], t.x[i], t.y[i], t.h[i], t.r[i], t.cameras[i]));
             }
         }
-        let out = dir
-            .join(&d.dataset)
-            .join(format!("{}_tracks.mcap", d.name));
-        let n = write_tracks(&d.path, &out, &p.tracks_topic, &p.world_frame, 2.0 * d.dt_s, &frames)
-            .with_context(|| format!("writing tracks of {} to {}", d.path.display(), out.display()))?;
+        let out = dir.join(&d.dataset).join(format!("{}_tracks.mcap", d.name));
+        let n = write_tracks(
+            &d.path,
+            &out,
+            &p.tracks_topic,
+            &p.world_frame,
+            2.0 * d.dt_s,
+            &frames,
+        )
+        .with_context(|| {
+            format!(
+                "writing tracks of {} to {}",
+                d.path.display(),
+                out.display()
+            )
+        })?;
         lines.push(format!(
             "Tracks of {}/{} written to {} ({n} MarkerArray messages on {}).",
             d.dataset,

@@ -142,7 +142,12 @@ fn graph_params(p: &Params, dt_s: f64) -> GraphParams {
     }
 }
 
-pub(crate) fn cylinder_params(p: &Params, dt_s: f64, selection: Selection, n_app: u32) -> CylinderParams {
+pub(crate) fn cylinder_params(
+    p: &Params,
+    dt_s: f64,
+    selection: Selection,
+    n_app: u32,
+) -> CylinderParams {
     CylinderParams {
         p_th_px: p.p_th_px,
         n_app,
@@ -209,7 +214,11 @@ fn boxes_from_truth(gt: &PeopleFrame, camera: &str) -> Vec<(u32, Box2d)> {
     out
 }
 
-fn nearest_truth<'a>(truth: &'a [(Nanos, PeopleFrame)], t: Nanos, tol_ns: u64) -> Option<&'a PeopleFrame> {
+fn nearest_truth<'a>(
+    truth: &'a [(Nanos, PeopleFrame)],
+    t: Nanos,
+    tol_ns: u64,
+) -> Option<&'a PeopleFrame> {
     let stamps: Vec<Nanos> = truth.iter().map(|x| x.0).collect();
     crate::log::sync::nearest(&stamps, t, tol_ns).map(|i| &truth[i].1)
 }
@@ -312,7 +321,9 @@ fn head_centroid_frame(
     // per person: (camera, head, centroid, visibility, statically occluded)
     let mut assoc: BTreeMap<u32, Vec<(usize, [f64; 2], [f64; 2], f64, bool)>> = BTreeMap::new();
     for (c, cam) in cameras.iter().enumerate() {
-        let Some(dets) = per_camera.get(c) else { continue };
+        let Some(dets) = per_camera.get(c) else {
+            continue;
+        };
         let mut pairs = Vec::new();
         for person in &gt.people {
             let Some(view) = person.cameras.iter().find(|v| &v.camera == cam) else {
@@ -349,7 +360,9 @@ fn head_centroid_frame(
         }
     }
     for person in &gt.people {
-        let Some(list) = assoc.get(&person.id) else { continue };
+        let Some(list) = assoc.get(&person.id) else {
+            continue;
+        };
         if list.len() < 2 {
             continue;
         }
@@ -461,20 +474,34 @@ pub(crate) fn process(
     let mut decode_failures = 0usize;
     let mut missing_camera_frames = 0usize;
     let mut frames: Vec<FrameRec> = Vec::new();
-    let mut cam_rows: (Vec<i64>, Vec<String>, Vec<f64>, Vec<f64>, Vec<i64>, Vec<i64>) = Default::default();
+    let mut cam_rows: (
+        Vec<i64>,
+        Vec<String>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<i64>,
+        Vec<i64>,
+    ) = Default::default();
     let mut pending: Vec<Option<Payload>> = (0..n_cams).map(|_| None).collect();
     let mut pending_stamp: Option<Nanos> = None;
     let mut first_error: Option<String> = None;
 
     // process one assembled frame
     let flush = |pending: &mut Vec<Option<Payload>>,
-                     stamp: Nanos,
-                     chains: &mut Vec<CameraChain>,
-                     frames: &mut Vec<FrameRec>,
-                     cam_rows: &mut (Vec<i64>, Vec<String>, Vec<f64>, Vec<f64>, Vec<i64>, Vec<i64>),
-                     decode_failures: &mut usize,
-                     missing: &mut usize,
-                     first_error: &mut Option<String>| {
+                 stamp: Nanos,
+                 chains: &mut Vec<CameraChain>,
+                 frames: &mut Vec<FrameRec>,
+                 cam_rows: &mut (
+        Vec<i64>,
+        Vec<String>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<i64>,
+        Vec<i64>,
+    ),
+                 decode_failures: &mut usize,
+                 missing: &mut usize,
+                 first_error: &mut Option<String>| {
         let payloads: Vec<Option<Payload>> = pending.iter_mut().map(Option::take).collect();
         let outs: Vec<CameraOut> = chains
             .par_iter_mut()
@@ -496,8 +523,11 @@ pub(crate) fn process(
                                     out.threshold = seg.threshold;
                                     out.foreground_frac = seg.foreground as f64
                                         / (f64::from(rgb.width()) * f64::from(rgb.height()));
-                                    out.detections =
-                                        template::detect(&chain.mask, &chain.templates, &det_params);
+                                    out.detections = template::detect(
+                                        &chain.mask,
+                                        &chain.templates,
+                                        &det_params,
+                                    );
                                     out.detections
                                         .iter()
                                         .map(|d| Box2d {
@@ -545,7 +575,8 @@ pub(crate) fn process(
             if let Some(e) = o.failed {
                 *decode_failures += 1;
                 if first_error.is_none() {
-                    *first_error = Some(format!("camera {c} at {:.3} s: {e}", stamp.0 as f64 * 1e-9));
+                    *first_error =
+                        Some(format!("camera {c} at {:.3} s: {e}", stamp.0 as f64 * 1e-9));
                 }
             }
             if use_images {
@@ -575,7 +606,9 @@ pub(crate) fn process(
             }
             continue;
         }
-        let Some(&c) = role.get(m.topic()) else { continue };
+        let Some(&c) = role.get(m.topic()) else {
+            continue;
+        };
         let decoded = if use_images {
             match m.channel.schema_name() {
                 "sensor_msgs/msg/Image" | "foxglove.RawImage" => decoders
@@ -718,12 +751,25 @@ pub(crate) fn process(
     bar.set_message("3-D");
     let results: Vec<anyhow::Result<VariantOut>> = variants
         .par_iter()
-        .map(|&(si, sel, n)| run_variant(&calib.views, cylinder_params(p, dt_s, sel, n), &sources[si].1))
+        .map(|&(si, sel, n)| {
+            run_variant(
+                &calib.views,
+                cylinder_params(p, dt_s, sel, n),
+                &sources[si].1,
+            )
+        })
         .collect();
 
     let mut tc = TrackCols::default();
-    let mut vrows: (Vec<String>, Vec<String>, Vec<i64>, Vec<i64>, Vec<i64>, Vec<i64>, Vec<i64>) =
-        Default::default();
+    let mut vrows: (
+        Vec<String>,
+        Vec<String>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<i64>,
+        Vec<i64>,
+    ) = Default::default();
     let support_text = |sup: &[(usize, u32)]| {
         sup.iter()
             .map(|(c, id)| format!("{}:{id}", p.cameras[*c]))
@@ -763,15 +809,26 @@ pub(crate) fn process(
                 tc.meas_x_m.push(m.map(|h| h.head_m.x));
                 tc.meas_y_m.push(m.map(|h| h.head_m.y));
                 tc.meas_height_m.push(m.map(|h| h.head_m.z));
-                tc.meas_radius_m.push(m.map(|h| h.radius_m).filter(|r| r.is_finite()));
+                tc.meas_radius_m
+                    .push(m.map(|h| h.radius_m).filter(|r| r.is_finite()));
             }
         }
     }
     bar.inc(1);
 
     // ground truth per frame
-    let mut g: (Vec<i64>, Vec<i64>, Vec<f64>, Vec<i64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, Vec<i64>, Vec<bool>) =
-        Default::default();
+    let mut g: (
+        Vec<i64>,
+        Vec<i64>,
+        Vec<f64>,
+        Vec<i64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<i64>,
+        Vec<bool>,
+    ) = Default::default();
     let room = p.room_m;
     for (k, (f, gt)) in frames.iter().zip(&gt_for_frame).enumerate() {
         let Some(gt) = gt else { continue };
@@ -788,11 +845,16 @@ pub(crate) fn process(
                 person
                     .cameras
                     .iter()
-                    .filter(|v| v.bbox.is_some() && v.visibility > 0.0 && p.cameras.contains(&v.camera))
+                    .filter(|v| {
+                        v.bbox.is_some() && v.visibility > 0.0 && p.cameras.contains(&v.camera)
+                    })
                     .count() as i64,
             );
             g.9.push(
-                person.x >= room[0] && person.x <= room[2] && person.y >= room[1] && person.y <= room[3],
+                person.x >= room[0]
+                    && person.x <= room[2]
+                    && person.y >= room[1]
+                    && person.y <= room[3],
             );
         }
     }
@@ -805,7 +867,11 @@ pub(crate) fn process(
             let per_cam: Vec<Vec<([f64; 4], [f64; 2], [f64; 2])>> = frames[k]
                 .detections
                 .iter()
-                .map(|ds| ds.iter().map(|d| (d.bbox, d.head_px, d.centroid_px)).collect())
+                .map(|ds| {
+                    ds.iter()
+                        .map(|d| (d.bbox, d.head_px, d.centroid_px))
+                        .collect()
+                })
                 .collect();
             head_centroid_frame(
                 &mut hc,
@@ -917,7 +983,9 @@ pub(crate) fn images_at(
     let mut decoders = Decoders::new();
     for m in log.messages_on(&topics)? {
         let m = m?;
-        let Some(c) = t.image.iter().position(|tp| tp == m.topic()) else { continue };
+        let Some(c) = t.image.iter().position(|tp| tp == m.topic()) else {
+            continue;
+        };
         let img = match m.channel.schema_name() {
             "sensor_msgs/msg/Image" | "foxglove.RawImage" => {
                 let i = decoders.typed::<Image>(log_ref(&log), &m)?;
