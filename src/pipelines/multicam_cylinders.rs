@@ -255,13 +255,13 @@ impl Experiment for MulticamCylinders {
         if p.n_app == 0 || p.n_dis == 0 {
             bad("n_app", "N_app and N_dis must be at least 1 frame".into());
         }
-        if p.n_app_sweep.iter().any(|&n| n == 0) {
+        if p.n_app_sweep.contains(&0) {
             bad("n_app_sweep", "values must be at least 1".into());
         }
         if p.match_m.is_empty() || p.match_m.iter().any(|&m| !(m > 0.0 && m.is_finite())) {
             bad("match_m", "needs positive distances in metres".into());
         }
-        if !(p.head_height_m[0] < p.head_height_m[1]) {
+        if p.head_height_m[0].partial_cmp(&p.head_height_m[1]) != Some(std::cmp::Ordering::Less) {
             bad("head_height_m", "the range is empty".into());
         }
         if !(p.room_m[0] < p.room_m[2] && p.room_m[1] < p.room_m[3]) {

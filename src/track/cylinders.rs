@@ -153,7 +153,8 @@ impl CylinderParams {
         if !(self.dt_s.is_finite() && self.dt_s > 0.0) {
             return bad("dt_s", format!("{} is not a positive period", self.dt_s));
         }
-        if !(self.head_height_m.0 < self.head_height_m.1) {
+        if self.head_height_m.0.partial_cmp(&self.head_height_m.1) != Some(std::cmp::Ordering::Less)
+        {
             return bad("head_height_m", "the range is empty".into());
         }
         Ok(())
@@ -372,7 +373,8 @@ impl CylinderTracker {
         }
         let n = combo.len();
         let e_m = sum / n as f64;
-        if !(e_m <= p.p_th_px) {
+        // NaN fails too
+        if e_m.is_nan() || e_m > p.p_th_px {
             return None;
         }
         let support3: Vec<(&CalibratedView, [f64; 2], f64)> = combo

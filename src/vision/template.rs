@@ -535,7 +535,7 @@ mod tests {
         let s = score_at(&sums, &t, 10, 5, 0.0, 0.5).expect("allowed");
         let want = 1.0 - f64::from(t.area) / f64::from(t.width * t.height);
         assert!((s - want).abs() < 1e-12);
-        assert!(detect(&mask, &[t.clone()], &DetectorParams::default()).is_empty());
+        assert!(detect(&mask, std::slice::from_ref(&t), &DetectorParams::default()).is_empty());
         // a full window scores the fraction of the window inside the silhouette
         let full = Mask {
             width: 80,

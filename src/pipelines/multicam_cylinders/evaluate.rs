@@ -4,6 +4,9 @@
 //! session, so nothing can match across sessions): CLEAR MOT counts are then the sums over
 //! sessions, as motmetrics' `OVERALL` row.
 
+// Tables are built column by column in tuples of vectors, one per column.
+#![allow(clippy::type_complexity)]
+
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 

@@ -1,6 +1,9 @@
 //! One session: calibration, the per-camera image stages, the 3-D runs, and the per-session
 //! tables the aggregation reads.
 
+// Tables are built column by column in tuples of vectors, one per column.
+#![allow(clippy::type_complexity)]
+
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -214,11 +217,7 @@ fn boxes_from_truth(gt: &PeopleFrame, camera: &str) -> Vec<(u32, Box2d)> {
     out
 }
 
-fn nearest_truth<'a>(
-    truth: &'a [(Nanos, PeopleFrame)],
-    t: Nanos,
-    tol_ns: u64,
-) -> Option<&'a PeopleFrame> {
+fn nearest_truth(truth: &[(Nanos, PeopleFrame)], t: Nanos, tol_ns: u64) -> Option<&PeopleFrame> {
     let stamps: Vec<Nanos> = truth.iter().map(|x| x.0).collect();
     crate::log::sync::nearest(&stamps, t, tol_ns).map(|i| &truth[i].1)
 }
