@@ -5,7 +5,7 @@ VENV := target/py-venv
 # py-motmetrics needs numpy 1, OpenCV 4.12 numpy 2: separate throwaway environments
 VENV_MOT := target/py-venv-mot
 
-.PHONY: help eval datasets release test bench interop clean opencv-agreement bench-gmm
+.PHONY: help eval datasets release test bench interop clean opencv-agreement bench-gmm bench-multicam
 
 PROFILE ?= quick
 
@@ -19,6 +19,7 @@ help:
 	@echo "make opencv-agreement  pixel agreement of vision::gmm masks with OpenCV MOG2 (throwaway venv)"
 	@echo "make bench-mlp         appearance-model training (10 splits) beside scikit-learn MLPRegressor, with the ratio"
 	@echo "make bench-gmm         adaptive GMM frames/s beside OpenCV MOG2 on the same frames, with ratios"
+	@echo "make bench-multicam    seed 004: frames/s of the whole multicam_cylinders pipeline per camera and of the Gabor background alone"
 	@echo "make clean     remove build outputs and out/"
 
 release:
@@ -53,6 +54,12 @@ bench: $(VENV)/ok
 	$(MAKE) bench-mot
 	$(MAKE) bench-gmm
 	$(MAKE) bench-mlp
+	$(MAKE) bench-multicam
+
+# Seed 004: the whole multicam_cylinders processing per camera frame and the Gabor stage alone
+# (a 2 s multicam_office session is synthesized into target/bench-data/ on first use).
+bench-multicam:
+	$(CARGO) bench --bench multicam -- --noplot
 
 # py-motmetrics 1.4.0 calls np.asfarray, which numpy 2 removed: pin the last numpy 1 stack.
 $(VENV_MOT)/mot-ok:

@@ -19,6 +19,7 @@ fn opts(out: &Path) -> RunOptions {
         out: out.to_path_buf(),
         git_commit: "test".into(),
         progress: false,
+        write_tracks: None,
     }
 }
 

@@ -92,6 +92,7 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         out: out_root.clone(),
         git_commit: super::git_commit(),
         progress: super::stderr_is_terminal(),
+        write_tracks: None,
     };
     let mut runs = Vec::new();
     for f in &files {

@@ -29,6 +29,10 @@ pub struct Args {
     /// Output root.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
+    /// Write the tracks back into a copy of each log (as visualization_msgs/msg/MarkerArray,
+    /// for Foxglove) under DIR (default: <out>/tracks), for pipelines that produce tracks.
+    #[arg(long, value_name = "DIR", num_args = 0..=1, default_missing_value = "")]
+    pub write_tracks: Option<PathBuf>,
 }
 
 fn parse_shard(s: &str) -> Result<(usize, usize), String> {
@@ -53,6 +57,13 @@ pub fn options(a: &Args, progress: bool) -> RunOptions {
         out: a.out.clone(),
         git_commit: super::git_commit(),
         progress,
+        write_tracks: a.write_tracks.as_ref().map(|d| {
+            if d.as_os_str().is_empty() {
+                a.out.join("tracks")
+            } else {
+                d.clone()
+            }
+        }),
     }
 }
 

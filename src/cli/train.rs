@@ -61,6 +61,7 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         out: a.out.clone(),
         git_commit: super::git_commit(),
         progress: super::stderr_is_terminal(),
+        write_tracks: None,
     };
     atomic::sweep_scratch(&a.out)?;
     let s = pipelines::run_file(&a.config, &opts)?;

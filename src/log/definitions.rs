@@ -1,4 +1,5 @@
-//! Canonical ROS 2 message definitions (Humble/Jazzy `common_interfaces`, `vision_msgs` 4.x)
+//! Canonical ROS 2 message definitions (Humble/Jazzy `common_interfaces`, `vision_msgs` 4.x;
+//! `visualization_msgs/Marker` in its Humble layout; files carry the text, so any reader decodes it)
 //! for the types peopletrack writes, and the rosbag2-style full schema text built from them:
 //! the type's own definition followed by each dependency, depth first in order of first use,
 //! each after a line of 80 `=` and `MSG: pkg/Type` — the layout `ros2 bag record` and
@@ -130,6 +131,22 @@ const DEFINITIONS: &[(&str, &str)] = &[
         "vision_msgs/msg/Detection2DArray",
         "std_msgs/Header header\nDetection2D[] detections\n",
     ),
+    (
+        "std_msgs/msg/ColorRGBA",
+        "float32 r\nfloat32 g\nfloat32 b\nfloat32 a\n",
+    ),
+    (
+        "visualization_msgs/msg/Marker",
+        "int32 ARROW=0\nint32 CUBE=1\nint32 SPHERE=2\nint32 CYLINDER=3\nint32 LINE_STRIP=4\n\
+         int32 LINE_LIST=5\nint32 CUBE_LIST=6\nint32 SPHERE_LIST=7\nint32 POINTS=8\n\
+         int32 TEXT_VIEW_FACING=9\nint32 MESH_RESOURCE=10\nint32 TRIANGLE_LIST=11\nint32 ADD=0\n\
+         int32 MODIFY=0\nint32 DELETE=2\nint32 DELETEALL=3\nstd_msgs/Header header\nstring ns\n\
+         int32 id\nint32 type\nint32 action\ngeometry_msgs/Pose pose\ngeometry_msgs/Vector3 scale\n\
+         std_msgs/ColorRGBA color\nbuiltin_interfaces/Duration lifetime\nbool frame_locked\n\
+         geometry_msgs/Point[] points\nstd_msgs/ColorRGBA[] colors\nstring text\n\
+         string mesh_resource\nbool mesh_use_embedded_materials\n",
+    ),
+    ("visualization_msgs/msg/MarkerArray", "Marker[] markers\n"),
 ];
 
 const SEPARATOR: &str =

@@ -780,6 +780,165 @@ impl RosMessage for Detection2DArray {
     }
 }
 
+/// `visualization_msgs/msg/Marker` (Humble layout): shapes a 3-D view draws, e.g. the
+/// cylinders of tracked people. Only what peopletrack writes is typed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Marker {
+    pub header: Header,
+    pub ns: String,
+    pub id: i32,
+    /// `Marker::CYLINDER`, `Marker::TEXT_VIEW_FACING`, ...
+    pub kind: i32,
+    /// `Marker::ADD`, `Marker::DELETE`, `Marker::DELETEALL`.
+    pub action: i32,
+    pub pose: Pose,
+    pub scale: Vector3<f64>,
+    /// RGBA in [0, 1].
+    pub color: [f32; 4],
+    /// How long the marker stays without an update (zero: forever).
+    pub lifetime: Time,
+    pub frame_locked: bool,
+    pub points: Vec<Point3<f64>>,
+    pub colors: Vec<[f32; 4]>,
+    pub text: String,
+    pub mesh_resource: String,
+    pub mesh_use_embedded_materials: bool,
+}
+
+impl Marker {
+    pub const CUBE: i32 = 1;
+    pub const SPHERE: i32 = 2;
+    pub const CYLINDER: i32 = 3;
+    pub const LINE_STRIP: i32 = 4;
+    pub const TEXT_VIEW_FACING: i32 = 9;
+    pub const ADD: i32 = 0;
+    pub const DELETE: i32 = 2;
+    pub const DELETEALL: i32 = 3;
+}
+
+impl Default for Marker {
+    fn default() -> Self {
+        Marker {
+            header: Header::default(),
+            ns: String::new(),
+            id: 0,
+            kind: Marker::CUBE,
+            action: Marker::ADD,
+            pose: Pose::default(),
+            scale: Vector3::new(1.0, 1.0, 1.0),
+            color: [1.0, 1.0, 1.0, 1.0],
+            lifetime: Time::default(),
+            frame_locked: false,
+            points: Vec::new(),
+            colors: Vec::new(),
+            text: String::new(),
+            mesh_resource: String::new(),
+            mesh_use_embedded_materials: false,
+        }
+    }
+}
+
+fn rgba_from(mut v: Value) -> Result<[f32; 4]> {
+    Ok([
+        field(&mut v, "r", |x| x.as_f64().map(|f| f as f32))?,
+        field(&mut v, "g", |x| x.as_f64().map(|f| f as f32))?,
+        field(&mut v, "b", |x| x.as_f64().map(|f| f as f32))?,
+        field(&mut v, "a", |x| x.as_f64().map(|f| f as f32))?,
+    ])
+}
+
+fn rgba_value(c: &[f32; 4]) -> Value {
+    record([
+        ("r", Value::F32(c[0])),
+        ("g", Value::F32(c[1])),
+        ("b", Value::F32(c[2])),
+        ("a", Value::F32(c[3])),
+    ])
+}
+
+impl RosMessage for Marker {
+    const TYPE_NAME: &'static str = "visualization_msgs/msg/Marker";
+
+    fn from_value(mut v: Value) -> Result<Self> {
+        Ok(Marker {
+            header: field(&mut v, "header", Header::from_value)?,
+            ns: field(&mut v, "ns", Value::into_string)?,
+            id: field(&mut v, "id", |x| x.as_i32())?,
+            kind: field(&mut v, "type", |x| x.as_i32())?,
+            action: field(&mut v, "action", |x| x.as_i32())?,
+            pose: field(&mut v, "pose", Pose::from_value)?,
+            scale: field(&mut v, "scale", vector_from)?,
+            color: field(&mut v, "color", rgba_from)?,
+            lifetime: field(&mut v, "lifetime", Time::from_value)?,
+            frame_locked: field(&mut v, "frame_locked", |x| x.as_bool())?,
+            points: field(&mut v, "points", |a| each(a, point_from))?,
+            colors: field(&mut v, "colors", |a| each(a, rgba_from))?,
+            text: field(&mut v, "text", Value::into_string)?,
+            mesh_resource: field(&mut v, "mesh_resource", Value::into_string)?,
+            mesh_use_embedded_materials: field(&mut v, "mesh_use_embedded_materials", |x| {
+                x.as_bool()
+            })?,
+        })
+    }
+
+    fn to_value(&self) -> Value {
+        record([
+            ("header", self.header.to_value()),
+            ("ns", Value::String(self.ns.clone())),
+            ("id", Value::I32(self.id)),
+            ("type", Value::I32(self.kind)),
+            ("action", Value::I32(self.action)),
+            ("pose", self.pose.to_value()),
+            ("scale", xyz_value(self.scale.x, self.scale.y, self.scale.z)),
+            ("color", rgba_value(&self.color)),
+            ("lifetime", self.lifetime.to_value()),
+            ("frame_locked", Value::Bool(self.frame_locked)),
+            (
+                "points",
+                Value::Array(
+                    self.points
+                        .iter()
+                        .map(|p| xyz_value(p.x, p.y, p.z))
+                        .collect(),
+                ),
+            ),
+            (
+                "colors",
+                Value::Array(self.colors.iter().map(rgba_value).collect()),
+            ),
+            ("text", Value::String(self.text.clone())),
+            ("mesh_resource", Value::String(self.mesh_resource.clone())),
+            (
+                "mesh_use_embedded_materials",
+                Value::Bool(self.mesh_use_embedded_materials),
+            ),
+        ])
+    }
+}
+
+/// `visualization_msgs/msg/MarkerArray`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MarkerArray {
+    pub markers: Vec<Marker>,
+}
+
+impl RosMessage for MarkerArray {
+    const TYPE_NAME: &'static str = "visualization_msgs/msg/MarkerArray";
+
+    fn from_value(mut v: Value) -> Result<Self> {
+        Ok(MarkerArray {
+            markers: field(&mut v, "markers", |a| each(a, Marker::from_value))?,
+        })
+    }
+
+    fn to_value(&self) -> Value {
+        record([(
+            "markers",
+            Value::Array(self.markers.iter().map(Marker::to_value).collect()),
+        )])
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -839,6 +998,30 @@ mod tests {
             linear: Vector3::new(1.0, 0.0, 0.0),
             angular: Vector3::new(0.0, 0.0, 0.1),
             twist_covariance: [0.0; 36],
+        });
+        round_trip(&MarkerArray {
+            markers: vec![
+                Marker {
+                    header: header.clone(),
+                    ns: "people".into(),
+                    id: 7,
+                    kind: Marker::CYLINDER,
+                    scale: Vector3::new(0.4, 0.4, 1.8),
+                    color: [0.0, 0.5, 1.0, 0.6],
+                    lifetime: Time {
+                        sec: 0,
+                        nanosec: 80_000_000,
+                    },
+                    ..Default::default()
+                },
+                Marker {
+                    kind: Marker::LINE_STRIP,
+                    points: vec![Point3::new(1.0, 2.0, 0.0), Point3::new(1.5, 2.0, 0.0)],
+                    colors: vec![[1.0, 0.0, 0.0, 1.0]; 2],
+                    text: "7".into(),
+                    ..Default::default()
+                },
+            ],
         });
         round_trip(&Detection2DArray {
             header: header.clone(),

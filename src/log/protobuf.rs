@@ -307,5 +307,6 @@ ros_only!(
     msgs::Imu,
     msgs::PoseArray,
     msgs::Detection2DArray,
+    msgs::MarkerArray,
     TransformStamped
 );

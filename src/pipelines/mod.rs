@@ -4,6 +4,7 @@
 pub mod background_tracking;
 pub mod columns;
 pub mod dataset_quality;
+pub mod multicam_cylinders;
 pub mod omni_appearance;
 
 use std::path::Path;
@@ -14,6 +15,7 @@ use crate::run::{Experiment, RunOptions, RunSummary, config, run_experiment, unk
 pub const KINDS: &[&str] = &[
     background_tracking::BackgroundTracking::KIND,
     dataset_quality::DatasetQuality::KIND,
+    multicam_cylinders::MulticamCylinders::KIND,
     omni_appearance::OmniAppearance::KIND,
 ];
 
@@ -26,6 +28,9 @@ pub fn run_file(path: &Path, opts: &RunOptions) -> anyhow::Result<RunSummary> {
         }
         dataset_quality::DatasetQuality::KIND => {
             run_experiment::<dataset_quality::DatasetQuality>(path, &text, opts)
+        }
+        multicam_cylinders::MulticamCylinders::KIND => {
+            run_experiment::<multicam_cylinders::MulticamCylinders>(path, &text, opts)
         }
         omni_appearance::OmniAppearance::KIND => {
             run_experiment::<omni_appearance::OmniAppearance>(path, &text, opts)
@@ -59,6 +64,7 @@ mod tests {
                 out: dir.path().join("out"),
                 git_commit: String::new(),
                 progress: false,
+                write_tracks: None,
             };
             if let Err(e) = run_file(&path, &opts) {
                 let msg = format!("{e:#}");

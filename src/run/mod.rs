@@ -69,6 +69,9 @@ pub struct Products {
 pub struct Aggregate<'a> {
     pub sessions: &'a [(SessionRef, Frames)],
     pub provenance: Provenance,
+    /// `--write-tracks`: folder for copies of the logs with the tracks added (pipelines that
+    /// produce tracks; others ignore it).
+    pub write_tracks: Option<&'a Path>,
 }
 
 /// One experiment (paper reproduction) as the runner drives it.
@@ -117,6 +120,8 @@ pub struct RunOptions {
     pub git_commit: String,
     /// Show progress bars (off in tests).
     pub progress: bool,
+    /// Write tracks back into copies of the logs under this folder (`--write-tracks`).
+    pub write_tracks: Option<PathBuf>,
 }
 
 /// What a run did, for the report.
@@ -437,15 +442,19 @@ pub fn run_experiment<E: Experiment>(
     }
     if done.is_empty() {
         anyhow::bail!(
-            "{}: every session was skipped; first reason: {}",
+            "{}: every session was skipped; first: {}",
             path.display(),
-            summary.skipped.first().map_or("", |s| s.1.as_str())
+            summary
+                .skipped
+                .first()
+                .map_or(String::new(), |s| format!("{}: {}", s.0, s.1))
         );
     }
     let products = E::aggregate(
         &Aggregate {
             sessions: &done,
             provenance: provenance.clone(),
+            write_tracks: opts.write_tracks.as_deref(),
         },
         &file.params,
     )?;

@@ -1,4 +1,4 @@
-//! Vision stages: image kernels that turn camera frames into per-pixel masks.
+//! Vision stages: image kernels that turn camera frames into per-pixel masks and detections.
 //!
 //! - [`view`]: [`ImageView`], a borrowed, checked, tightly packed 8-bit image (grey or colour)
 //!   that every kernel here reads.
@@ -18,6 +18,8 @@
 //! - [`score`]: precision, recall and F-measure of a mask against a hand-segmented one.
 //! - [`synthetic`]: a deterministic synthetic RGB scene (textured background, noise, a
 //!   flickering region, a moving object with a shadow) for tests and benchmarks.
+//! - [`gabor`]: the Gabor-feature background model and MAD threshold of seed 004 §2.
+//! - [`template`]: human-silhouette template detection of seed 004 §3.
 //!
 //! Kernels read frames and write into buffers the caller owns; nothing here reads logs or
 //! writes files.
@@ -25,11 +27,13 @@
 pub mod blobs;
 pub mod colortrack;
 pub mod ellipse;
+pub mod gabor;
 pub mod gmm;
 pub mod local;
 pub mod omni;
 pub mod score;
 pub mod synthetic;
+pub mod template;
 pub mod view;
 
 pub use gmm::{AdaptiveGmm, GmmError, GmmParams};

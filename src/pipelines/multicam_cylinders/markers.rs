@@ -1,0 +1,180 @@
+//! Tracks back into MCAP: a copy of each session log with one more topic,
+//! `visualization_msgs/msg/MarkerArray` at every frame — a translucent cylinder per person
+//! (ground position, height, radius) and a text label with the track id, in the world frame.
+//! Foxglove's 3-D panel draws them with the scene, and its image panel projects them over the
+//! camera images through `/tf_static` and `camera_info`, which the copy keeps.
+//!
+//! Markers live for two frame periods, so a track that ends disappears without DELETE
+//! messages. Messages keep their log times; the markers are stamped and logged at the frame's
+//! header stamp and interleaved in time order with the copied messages.
+
+use std::path::Path;
+
+use anyhow::Context;
+use nalgebra::{Point3, Quaternion, Vector3};
+
+use super::Params;
+use super::evaluate::Scored;
+use crate::log::msgs::{Header, Marker, MarkerArray, Pose, Time};
+use crate::log::{ChannelId, SessionLog, SessionWriter, WriterOptions};
+use crate::report::figure::color;
+use crate::time::Nanos;
+
+/// Markers of one frame: `(stamp, [(id, x, y, height, radius, cameras)])`.
+pub(crate) type FrameTracks = (Nanos, Vec<(i64, f64, f64, f64, f64, i64)>);
+
+/// The marker array of one frame.
+pub(crate) fn markers_for(
+    frame_id: &str,
+    stamp: Nanos,
+    life_s: f64,
+    tracks: &[(i64, f64, f64, f64, f64, i64)],
+) -> MarkerArray {
+    let lifetime = Time {
+        sec: life_s.floor() as i32,
+        nanosec: ((life_s.fract()) * 1e9) as u32,
+    };
+    let mut markers = Vec::with_capacity(2 * tracks.len());
+    for &(id, x, y, h, r, cams) in tracks {
+        let c = color((id as usize % 7) + 1);
+        let rgba = [
+            f32::from(c.0) / 255.0,
+            f32::from(c.1) / 255.0,
+            f32::from(c.2) / 255.0,
+            0.45,
+        ];
+        let r = if r.is_finite() && r > 0.0 { r } else { 0.2 };
+        let h = if h.is_finite() && h > 0.0 { h } else { 1.7 };
+        let header = Header::new(stamp, frame_id);
+        markers.push(Marker {
+            header: header.clone(),
+            ns: "cylinders".into(),
+            id: id as i32,
+            kind: Marker::CYLINDER,
+            action: Marker::ADD,
+            pose: Pose {
+                position: Point3::new(x, y, h / 2.0),
+                orientation: Quaternion::identity(),
+            },
+            scale: Vector3::new(2.0 * r, 2.0 * r, h),
+            color: rgba,
+            lifetime,
+            ..Default::default()
+        });
+        markers.push(Marker {
+            header,
+            ns: "labels".into(),
+            id: id as i32,
+            kind: Marker::TEXT_VIEW_FACING,
+            action: Marker::ADD,
+            pose: Pose {
+                position: Point3::new(x, y, h + 0.25),
+                orientation: Quaternion::identity(),
+            },
+            scale: Vector3::new(0.0, 0.0, 0.25),
+            color: [rgba[0], rgba[1], rgba[2], 1.0],
+            lifetime,
+            text: format!("{id} ({cams} cams)"),
+            ..Default::default()
+        });
+    }
+    MarkerArray { markers }
+}
+
+/// Copy `input` to `output` with the tracks added as markers on `topic`; returns the number of
+/// marker messages written.
+pub(crate) fn write_tracks(
+    input: &Path,
+    output: &Path,
+    topic: &str,
+    frame_id: &str,
+    life_s: f64,
+    frames: &[FrameTracks],
+) -> anyhow::Result<usize> {
+    let log = SessionLog::open(input)?;
+    let mut w = SessionWriter::create(output, &WriterOptions::default())?;
+    for m in &log.summary().metadata {
+        w.metadata(&m.name, m.entries.clone())?;
+    }
+    let mut channels: std::collections::BTreeMap<u16, ChannelId> = Default::default();
+    for (id, ch) in &log.summary().channels {
+        let schema = ch
+            .schema
+            .as_deref()
+            .map(|s| (s.name.as_str(), s.encoding.as_str(), s.data.as_slice()));
+        channels.insert(*id, w.add_raw(&ch.topic, schema, &ch.message_encoding)?);
+    }
+    let markers = w.add_ros2::<MarkerArray>(topic)?;
+    let mut next = 0usize;
+    for m in log.messages()? {
+        let m = m?;
+        while next < frames.len() && frames[next].0 <= m.log_time {
+            let (stamp, tracks) = &frames[next];
+            w.write(
+                markers,
+                *stamp,
+                &markers_for(frame_id, *stamp, life_s, tracks),
+            )?;
+            next += 1;
+        }
+        let ch = channels.get(&m.channel.id).with_context(|| {
+            format!(
+                "{}: channel {} not in the summary",
+                input.display(),
+                m.channel.id
+            )
+        })?;
+        w.write_bytes(*ch, m.log_time, &m.data)?;
+    }
+    for (stamp, tracks) in &frames[next..] {
+        w.write(
+            markers,
+            *stamp,
+            &markers_for(frame_id, *stamp, life_s, tracks),
+        )?;
+    }
+    w.finish()?;
+    Ok(frames.len())
+}
+
+/// Write every session's tracks (main run) under `dir`.
+pub(super) fn write_all(s: &Scored, p: &Params, dir: &Path) -> anyhow::Result<Vec<String>> {
+    let mut lines = Vec::new();
+    for d in &s.data {
+        let t = &d.tracks;
+        let mut frames: Vec<FrameTracks> = Vec::new();
+        for i in t.rows(&s.main) {
+            let stamp = Nanos(t.stamp_ns[i] as u64);
+            if frames.last().is_none_or(|f| f.0 != stamp) {
+                frames.push((stamp, Vec::new()));
+            }
+            if let Some(f) = frames.last_mut() {
+                f.1.push((t.id[i], t.x[i], t.y[i], t.h[i], t.r[i], t.cameras[i]));
+            }
+        }
+        let out = dir.join(&d.dataset).join(format!("{}_tracks.mcap", d.name));
+        let n = write_tracks(
+            &d.path,
+            &out,
+            &p.tracks_topic,
+            &p.world_frame,
+            2.0 * d.dt_s,
+            &frames,
+        )
+        .with_context(|| {
+            format!(
+                "writing tracks of {} to {}",
+                d.path.display(),
+                out.display()
+            )
+        })?;
+        lines.push(format!(
+            "Tracks of {}/{} written to {} ({n} MarkerArray messages on {}).",
+            d.dataset,
+            d.name,
+            out.display(),
+            p.tracks_topic
+        ));
+    }
+    Ok(lines)
+}

@@ -1,0 +1,582 @@
+//! People detection by correlating human-silhouette templates with a foreground mask
+//! (seed 004 §3, eq. 3).
+//!
+//! **Templates.** A silhouette is a binary shape built from a fixed human profile (head,
+//! neck, shoulders, torso, legs; half-widths as fractions of the body height) at a pixel
+//! height and a tilt (the angle of the feet → head direction from the image vertical). The
+//! set is constrained by the calibration and the room size, as the paper says: a person of
+//! the nominal height is placed on a grid over the room floor, projected into the camera, and
+//! the image heights and tilts seen there give `n_scales` heights (geometric steps between the
+//! 5th and 95th percentiles) × `n_tilts` tilts (evenly spaced percentiles) — 4 × 4 = 16
+//! templates by default, the paper's count.
+//!
+//! **Correlation.** For a template `T` (its bounding window, 1 inside the silhouette, 0
+//! outside) placed with its top-left corner at `(x, y)` over the mask `S`, the matching error
+//! is the mean squared difference over the window (eq. 3, normalised by the window area so
+//! that templates of different sizes compare):
+//! `MSE = (|T| − 2 Σ T·S + Σ S) / A`, evaluated in O(rows) with per-row prefix sums (each
+//! silhouette row is one run of pixels). The detector reports the **matching score**
+//! `1 − MSE` ∈ [0, 1]; an empty window scores `1 − |T|/A` ≈ 0.5 and a perfect match 1. The
+//! paper thresholds its combined matching image in (0.6, 0.75) with "a high threshold value"
+//! rejecting shadows: that reads as a threshold on this similarity, which is how it is used
+//! here. The minimum error over templates at each position is the maximum score; its local
+//! extrema are kept by greedy non-maximum suppression in the image (a candidate survives if
+//! its box overlaps no better one by more than `nms_iou`), the paper's non-minimal
+//! suppression. Placements may hang over the image border (at least `min_inside` of the
+//! window inside, the head row inside); only the inside part is compared. A placement whose
+//! score cannot reach the threshold (bound `1 − |Σ T − Σ S| / A` from the window sum) is
+//! skipped without correlating.
+//!
+//! Each detection gives its box, the head point (the top of the silhouette, "vertically
+//! translating the correspondence coordinates according to the dimensions of the related
+//! human template", §4), the template's body width and height, and the centroid of the
+//! foreground pixels inside the box (the blob centroid the paper compares against, §5).
+//!
+//! What it does not do: no learned shapes, no per-position template choice (the whole set is
+//! tried everywhere), no sub-pixel positions (the search stride is a parameter).
+
+use nalgebra::Point3;
+
+use super::gabor::Mask;
+use crate::geometry::triangulate::CalibratedView;
+
+/// Paper's range for the detection threshold on the matching score: (0.6, 0.75).
+pub const THRESHOLD_RANGE: (f64, f64) = (0.6, 0.75);
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TemplateError {
+    #[error("no floor point of the room is seen by the camera: cannot size templates")]
+    NotVisible,
+    #[error("bad parameter `{name}`: {reason}")]
+    BadParameter { name: &'static str, reason: String },
+}
+
+/// Half-width of the human profile (fraction of the body height) at `v` ∈ [0, 1] from the
+/// top of the head.
+pub fn profile_half_width(v: f64) -> f64 {
+    const HEAD: f64 = 0.13;
+    if v < HEAD {
+        let c = HEAD / 2.0;
+        let t = ((v - c) / c).clamp(-1.0, 1.0);
+        0.052 * (1.0 - t * t).max(0.0).sqrt()
+    } else if v < 0.15 {
+        0.035
+    } else if v < 0.20 {
+        0.035 + (0.12 - 0.035) * (v - 0.15) / 0.05
+    } else if v < 0.5 {
+        0.12 - 0.015 * (v - 0.2) / 0.3
+    } else {
+        0.105 - 0.03 * (v - 0.5) / 0.5
+    }
+}
+
+/// One binary silhouette: a run `[start, end)` of template columns per row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Silhouette {
+    pub width: u32,
+    pub height: u32,
+    pub spans: Vec<(u32, u32)>,
+    /// Pixels inside the silhouette.
+    pub area: u32,
+    /// Top of the head in template coordinates (x, y).
+    pub head: (f64, f64),
+    /// Widest run (shoulders): the body width in pixels.
+    pub body_width_px: f64,
+    pub tilt_rad: f64,
+}
+
+impl Silhouette {
+    /// The silhouette of a person `height_px` tall whose head leans `tilt_rad` from the feet
+    /// (positive: head to the right of the feet).
+    pub fn new(height_px: f64, tilt_rad: f64) -> Silhouette {
+        let rows = height_px.round().max(8.0) as i64;
+        let hgt = rows as f64;
+        let lean = tilt_rad.tan();
+        let mut raw = Vec::with_capacity(rows as usize);
+        for r in 0..rows {
+            let v = (r as f64 + 0.5) / hgt;
+            let center = (1.0 - v) * hgt * lean;
+            let hw = (profile_half_width(v) * hgt).max(0.5);
+            raw.push(((center - hw).round() as i64, (center + hw).round() as i64));
+        }
+        let min_a = raw.iter().map(|s| s.0).min().unwrap_or(0);
+        let max_b = raw.iter().map(|s| s.1).max().unwrap_or(1);
+        let spans: Vec<(u32, u32)> = raw
+            .iter()
+            .map(|&(a, b)| ((a - min_a) as u32, ((b - min_a).max(a - min_a + 1)) as u32))
+            .collect();
+        let area = spans.iter().map(|(a, b)| b - a).sum();
+        let body_width_px = spans.iter().map(|(a, b)| b - a).max().unwrap_or(1) as f64;
+        Silhouette {
+            width: (max_b - min_a).max(1) as u32,
+            height: rows as u32,
+            area,
+            head: (hgt * lean - min_a as f64, 0.0),
+            spans,
+            body_width_px,
+            tilt_rad,
+        }
+    }
+}
+
+/// How a calibrated camera sees a person standing on the room floor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Appearance {
+    pub height_px: f64,
+    pub tilt_rad: f64,
+}
+
+/// Image heights and tilts of a person `person_height_m` tall standing on a grid (`step_m`)
+/// over the room floor `[x0, y0, x1, y1]` whose head the camera sees.
+pub fn appearances(
+    view: &CalibratedView,
+    room_m: [f64; 4],
+    person_height_m: f64,
+    step_m: f64,
+) -> Vec<Appearance> {
+    let mut out = Vec::new();
+    let nx = ((room_m[2] - room_m[0]) / step_m).floor().max(0.0) as usize;
+    let ny = ((room_m[3] - room_m[1]) / step_m).floor().max(0.0) as usize;
+    for i in 0..=nx {
+        for j in 0..=ny {
+            let (x, y) = (room_m[0] + i as f64 * step_m, room_m[1] + j as f64 * step_m);
+            let (Some(foot), Some(head)) = (
+                view.project(&Point3::new(x, y, 0.0)),
+                view.project(&Point3::new(x, y, person_height_m)),
+            ) else {
+                continue;
+            };
+            if !view.model.in_image(&head) {
+                continue;
+            }
+            let (dx, dy) = (head.x - foot.x, foot.y - head.y);
+            let height_px = dx.hypot(dy);
+            if height_px < 4.0 || dy <= 0.0 {
+                continue;
+            }
+            out.push(Appearance {
+                height_px,
+                tilt_rad: dx.atan2(dy),
+            });
+        }
+    }
+    out
+}
+
+fn percentile(sorted: &[f64], q: f64) -> f64 {
+    let pos = q.clamp(0.0, 1.0) * (sorted.len() - 1) as f64;
+    let (i, f) = (pos.floor() as usize, pos.fract());
+    let j = (i + 1).min(sorted.len() - 1);
+    sorted[i] * (1.0 - f) + sorted[j] * f
+}
+
+/// The calibration-constrained template set of one camera: `n_scales` heights × `n_tilts`
+/// tilts (see the module documentation).
+pub fn calibrated_templates(
+    view: &CalibratedView,
+    room_m: [f64; 4],
+    person_height_m: f64,
+    n_scales: usize,
+    n_tilts: usize,
+) -> Result<Vec<Silhouette>, TemplateError> {
+    if n_scales == 0 || n_tilts == 0 {
+        return Err(TemplateError::BadParameter {
+            name: "n_scales × n_tilts",
+            reason: "needs at least one template".into(),
+        });
+    }
+    let seen = appearances(view, room_m, person_height_m, 0.2);
+    if seen.is_empty() {
+        return Err(TemplateError::NotVisible);
+    }
+    let mut heights: Vec<f64> = seen.iter().map(|a| a.height_px).collect();
+    let mut tilts: Vec<f64> = seen.iter().map(|a| a.tilt_rad).collect();
+    heights.sort_by(f64::total_cmp);
+    tilts.sort_by(f64::total_cmp);
+    let (lo, hi) = (percentile(&heights, 0.05), percentile(&heights, 0.95));
+    let scales: Vec<f64> = (0..n_scales)
+        .map(|i| {
+            if n_scales == 1 {
+                (lo * hi).sqrt()
+            } else {
+                lo * (hi / lo).powf(i as f64 / (n_scales - 1) as f64)
+            }
+        })
+        .collect();
+    let tilt_set: Vec<f64> = (0..n_tilts)
+        .map(|i| percentile(&tilts, (i as f64 + 0.5) / n_tilts as f64))
+        .collect();
+    let mut out = Vec::with_capacity(n_scales * n_tilts);
+    for &s in &scales {
+        for &t in &tilt_set {
+            out.push(Silhouette::new(s, t));
+        }
+    }
+    Ok(out)
+}
+
+/// Detector settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DetectorParams {
+    /// Minimum matching score `1 − MSE` (paper: in (0.6, 0.75)).
+    pub threshold: f64,
+    /// Search stride (pixels).
+    pub stride_px: u32,
+    /// Greedy non-maximum suppression: a candidate whose box overlaps a better detection by
+    /// more than this IoU is dropped.
+    pub nms_iou: f64,
+    /// Fraction of a template window that must lie inside the image.
+    pub min_inside: f64,
+}
+
+impl Default for DetectorParams {
+    fn default() -> Self {
+        DetectorParams {
+            threshold: 0.7,
+            stride_px: 2,
+            nms_iou: 0.3,
+            min_inside: 0.5,
+        }
+    }
+}
+
+/// One detected person.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Detection {
+    /// `[x0, y0, x1, y1]` of the template window (may reach outside the image).
+    pub bbox: [f64; 4],
+    /// Top of the head (pixels).
+    pub head_px: [f64; 2],
+    /// Centroid of the foreground pixels inside the box (pixels); the head if there are none.
+    pub centroid_px: [f64; 2],
+    /// Body width and height of the template (pixels).
+    pub width_px: f64,
+    pub height_px: f64,
+    /// Matching score `1 − MSE`.
+    pub score: f64,
+    /// Index of the template.
+    pub template: usize,
+}
+
+/// Prefix sums of a mask: per row (`w + 1` per row) and 2-D (`(w + 1) × (h + 1)`).
+struct Sums {
+    w: usize,
+    h: usize,
+    rows: Vec<u32>,
+    integral: Vec<u32>,
+}
+
+impl Sums {
+    fn new(mask: &Mask) -> Sums {
+        let (w, h) = (mask.width as usize, mask.height as usize);
+        let mut rows = vec![0u32; (w + 1) * h];
+        let mut integral = vec![0u32; (w + 1) * (h + 1)];
+        for y in 0..h {
+            let mut acc = 0u32;
+            for x in 0..w {
+                acc += u32::from(mask.data[y * w + x]);
+                rows[y * (w + 1) + x + 1] = acc;
+                integral[(y + 1) * (w + 1) + x + 1] = integral[y * (w + 1) + x + 1] + acc;
+            }
+        }
+        Sums {
+            w,
+            h,
+            rows,
+            integral,
+        }
+    }
+
+    /// Foreground pixels in `[x0, x1) × [y0, y1)` (already clipped).
+    fn window(&self, x0: usize, y0: usize, x1: usize, y1: usize) -> u32 {
+        let s = self.w + 1;
+        self.integral[y1 * s + x1] + self.integral[y0 * s + x0]
+            - self.integral[y0 * s + x1]
+            - self.integral[y1 * s + x0]
+    }
+
+    fn row(&self, y: usize, x0: usize, x1: usize) -> u32 {
+        let s = self.w + 1;
+        self.rows[y * s + x1] - self.rows[y * s + x0]
+    }
+}
+
+/// Matching score of `t` with its top-left corner at `(x, y)`, or `None` when the placement
+/// is not allowed or cannot reach `threshold`.
+fn score_at(
+    sums: &Sums,
+    t: &Silhouette,
+    x: i64,
+    y: i64,
+    threshold: f64,
+    min_inside: f64,
+) -> Option<f64> {
+    let (w, h) = (sums.w as i64, sums.h as i64);
+    let (x0, y0) = (x.max(0), y.max(0));
+    let (x1, y1) = (
+        (x + i64::from(t.width)).min(w),
+        (y + i64::from(t.height)).min(h),
+    );
+    if x1 <= x0 || y1 <= y0 || y < 0 || y >= h {
+        return None;
+    }
+    let area = ((x1 - x0) * (y1 - y0)) as f64;
+    let full = f64::from(t.width) * f64::from(t.height);
+    if area < min_inside * full {
+        return None;
+    }
+    let sw = f64::from(sums.window(x0 as usize, y0 as usize, x1 as usize, y1 as usize));
+    let inside =
+        x0 == x && y0 == y && x1 == x + i64::from(t.width) && y1 == y + i64::from(t.height);
+    if inside && 1.0 - (f64::from(t.area) - sw).abs() / area < threshold {
+        return None; // cannot reach the threshold whatever the overlap
+    }
+    let (mut t1, mut c) = (0u32, 0u32);
+    for (r, &(a, b)) in t.spans.iter().enumerate() {
+        let yy = y + r as i64;
+        if yy < 0 {
+            continue;
+        }
+        if yy >= h {
+            break;
+        }
+        let (a, b) = (
+            (x + i64::from(a)).clamp(0, w),
+            (x + i64::from(b)).clamp(0, w),
+        );
+        if b > a {
+            t1 += (b - a) as u32;
+            c += sums.row(yy as usize, a as usize, b as usize);
+        }
+    }
+    let mse = (f64::from(t1) - 2.0 * f64::from(c) + sw) / area;
+    Some(1.0 - mse)
+}
+
+fn iou(a: &[f64; 4], b: &[f64; 4]) -> f64 {
+    let iw = (a[2].min(b[2]) - a[0].max(b[0])).max(0.0);
+    let ih = (a[3].min(b[3]) - a[1].max(b[1])).max(0.0);
+    let inter = iw * ih;
+    if inter <= 0.0 {
+        return 0.0;
+    }
+    let area = |r: &[f64; 4]| (r[2] - r[0]) * (r[3] - r[1]);
+    inter / (area(a) + area(b) - inter)
+}
+
+/// Detect people in a foreground mask with a template set.
+pub fn detect(mask: &Mask, templates: &[Silhouette], p: &DetectorParams) -> Vec<Detection> {
+    if mask.width == 0 || mask.height == 0 || templates.is_empty() {
+        return Vec::new();
+    }
+    let sums = Sums::new(mask);
+    let (w, h) = (i64::from(mask.width), i64::from(mask.height));
+    let stride = i64::from(p.stride_px.max(1));
+    // best score per position over templates (the paper's minimum of the MSE images)
+    let mut best: std::collections::BTreeMap<(i64, i64), (f64, usize)> = Default::default();
+    for (ti, t) in templates.iter().enumerate() {
+        let (tw, th) = (i64::from(t.width), i64::from(t.height));
+        // positions are anchored at the head so that every template shares one grid
+        let hx = t.head.0.round() as i64;
+        let mut y = 0;
+        while y < h {
+            let mut xh = -tw / 2 + hx;
+            while xh < w + tw / 2 {
+                let x = xh - hx;
+                if x + tw > 0
+                    && let Some(s) = score_at(&sums, t, x, y, p.threshold, p.min_inside)
+                    && s >= p.threshold
+                {
+                    let e = best.entry((xh, y)).or_insert((f64::NEG_INFINITY, 0));
+                    if s > e.0 {
+                        *e = (s, ti);
+                    }
+                }
+                xh += stride;
+            }
+            y += stride;
+            let _ = th;
+        }
+    }
+    let mut cands: Vec<(f64, i64, i64, usize)> = best
+        .into_iter()
+        .map(|((x, y), (s, t))| (s, y, x, t))
+        .collect();
+    // best first; ties broken by position and template for determinism
+    cands.sort_by(|a, b| {
+        b.0.total_cmp(&a.0)
+            .then(a.1.cmp(&b.1))
+            .then(a.2.cmp(&b.2))
+            .then(a.3.cmp(&b.3))
+    });
+    let mut out: Vec<Detection> = Vec::new();
+    for (score, y, xh, ti) in cands {
+        let t = &templates[ti];
+        let x = (xh - t.head.0.round() as i64) as f64;
+        let y = y as f64;
+        let bbox = [x, y, x + f64::from(t.width), y + f64::from(t.height)];
+        if out.iter().any(|d| iou(&d.bbox, &bbox) > p.nms_iou) {
+            continue;
+        }
+        let head_px = [x + t.head.0, y + t.head.1];
+        out.push(Detection {
+            bbox,
+            head_px,
+            centroid_px: centroid(mask, &bbox).unwrap_or(head_px),
+            width_px: t.body_width_px,
+            height_px: f64::from(t.height),
+            score,
+            template: ti,
+        });
+    }
+    out
+}
+
+/// Centroid of the foreground pixels of `mask` inside `bbox` (pixel centres at `i + 0.5`).
+pub fn centroid(mask: &Mask, bbox: &[f64; 4]) -> Option<[f64; 2]> {
+    let (w, h) = (i64::from(mask.width), i64::from(mask.height));
+    let x0 = (bbox[0].floor() as i64).clamp(0, w);
+    let x1 = (bbox[2].ceil() as i64).clamp(0, w);
+    let y0 = (bbox[1].floor() as i64).clamp(0, h);
+    let y1 = (bbox[3].ceil() as i64).clamp(0, h);
+    let (mut n, mut sx, mut sy) = (0u64, 0.0, 0.0);
+    for y in y0..y1 {
+        let row = &mask.data[(y * w) as usize..((y + 1) * w) as usize];
+        for x in x0..x1 {
+            if row[x as usize] != 0 {
+                n += 1;
+                sx += x as f64 + 0.5;
+                sy += y as f64 + 0.5;
+            }
+        }
+    }
+    (n > 0).then(|| [sx / n as f64, sy / n as f64])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Paint a silhouette into a mask at a top-left corner.
+    fn paint(mask: &mut Mask, t: &Silhouette, x: i64, y: i64) {
+        for (r, &(a, b)) in t.spans.iter().enumerate() {
+            let yy = y + r as i64;
+            if yy < 0 || yy >= i64::from(mask.height) {
+                continue;
+            }
+            for xx in (x + i64::from(a))..(x + i64::from(b)) {
+                if xx >= 0 && xx < i64::from(mask.width) {
+                    mask.data[(yy * i64::from(mask.width) + xx) as usize] = 1;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn profile_is_human_shaped() {
+        // shoulders wider than the head, head wider than the neck, legs narrower than shoulders
+        assert!(profile_half_width(0.3) > profile_half_width(0.06));
+        assert!(profile_half_width(0.06) > profile_half_width(0.14));
+        assert!(profile_half_width(0.8) < profile_half_width(0.25));
+        let s = Silhouette::new(100.0, 0.0);
+        assert_eq!(s.height, 100);
+        assert!((s.body_width_px - 24.0).abs() <= 1.0, "{}", s.body_width_px);
+        // upright: head at the middle column
+        assert!((s.head.0 - f64::from(s.width) / 2.0).abs() <= 1.0);
+        // filled fraction of the window: the profile's mean width over its widest (the
+        // shoulders, 2 · 0.12): head half-ellipse 0.13 · (π/4) · 0.052, neck 0.02 · 0.035,
+        // shoulder ramp 0.05 · 0.0775, torso 0.3 · 0.1125, legs 0.5 · 0.09
+        let closed = (0.13 * std::f64::consts::FRAC_PI_4 * 0.052
+            + 0.02 * 0.035
+            + 0.05 * 0.0775
+            + 0.3 * 0.1125
+            + 0.5 * 0.09)
+            / 0.12;
+        let fill = f64::from(s.area) / f64::from(s.width * s.height);
+        assert!((fill - closed).abs() < 0.02, "{fill} vs {closed}");
+        // a tilted one puts the head to the right of the feet
+        let t = Silhouette::new(100.0, 0.2);
+        let feet = t
+            .spans
+            .last()
+            .map(|(a, b)| f64::from(a + b) / 2.0)
+            .unwrap_or(0.0);
+        assert!(t.head.0 > feet + 10.0);
+    }
+
+    #[test]
+    fn a_painted_silhouette_is_found_with_a_perfect_score_at_its_place() {
+        let t = Silhouette::new(60.0, 0.0);
+        let mut mask = Mask::new(120, 90);
+        paint(&mut mask, &t, 31, 14);
+        let dets = detect(
+            &mask,
+            std::slice::from_ref(&t),
+            &DetectorParams {
+                stride_px: 1,
+                ..Default::default()
+            },
+        );
+        assert_eq!(dets.len(), 1, "{dets:?}");
+        let d = dets[0];
+        assert!((d.score - 1.0).abs() < 1e-12);
+        assert_eq!(d.bbox[0], 31.0);
+        assert_eq!(d.bbox[1], 14.0);
+        assert!((d.head_px[0] - (31.0 + t.head.0)).abs() < 1e-9);
+        assert_eq!(d.head_px[1], 14.0);
+    }
+
+    #[test]
+    fn mse_score_has_its_closed_form() {
+        // an empty mask scores 1 − |T| / A: below the threshold, so nothing is detected
+        let t = Silhouette::new(40.0, 0.0);
+        let mask = Mask::new(80, 60);
+        let sums = Sums::new(&mask);
+        let s = score_at(&sums, &t, 10, 5, 0.0, 0.5).expect("allowed");
+        let want = 1.0 - f64::from(t.area) / f64::from(t.width * t.height);
+        assert!((s - want).abs() < 1e-12);
+        assert!(detect(&mask, std::slice::from_ref(&t), &DetectorParams::default()).is_empty());
+        // a full window scores the fraction of the window inside the silhouette
+        let full = Mask {
+            width: 80,
+            height: 60,
+            data: vec![1; 80 * 60],
+        };
+        let sums = Sums::new(&full);
+        let s = score_at(&sums, &t, 10, 5, 0.0, 0.5).expect("allowed");
+        assert!((s - f64::from(t.area) / f64::from(t.width * t.height)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn lower_body_occlusion_lowers_the_score_but_stays_in_the_paper_range() {
+        // a desk hides the legs (lower 40 %): the score drops to ~0.75-0.8, still detected
+        let t = Silhouette::new(80.0, 0.0);
+        let mut mask = Mask::new(100, 100);
+        paint(&mut mask, &t, 30, 10);
+        for y in (10 + 48)..100 {
+            for x in 0..100 {
+                mask.data[y * 100 + x] = 0;
+            }
+        }
+        let dets = detect(&mask, std::slice::from_ref(&t), &DetectorParams::default());
+        assert_eq!(dets.len(), 1);
+        assert!(
+            dets[0].score > 0.7 && dets[0].score < 0.9,
+            "{}",
+            dets[0].score
+        );
+        // the blob centroid moved up, the head did not
+        assert!(dets[0].centroid_px[1] < 10.0 + 0.35 * 80.0);
+        assert!((dets[0].head_px[1] - 10.0).abs() <= 2.0);
+    }
+
+    #[test]
+    fn two_people_give_two_detections() {
+        let t = Silhouette::new(50.0, 0.0);
+        let mut mask = Mask::new(160, 80);
+        paint(&mut mask, &t, 20, 10);
+        paint(&mut mask, &t, 100, 20);
+        let dets = detect(&mask, std::slice::from_ref(&t), &DetectorParams::default());
+        assert_eq!(dets.len(), 2, "{dets:?}");
+    }
+}
