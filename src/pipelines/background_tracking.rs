@@ -37,6 +37,7 @@ use polars::prelude::*;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::columns::{f64s as col_f64, i64s as col_i64, opt_f64s as col_opt_f64, strs as col_str};
 use crate::Nanos;
 use crate::eval::mot::{self, BoxPx, Geometry, MatchRule, Metrics};
 use crate::eval::stats::{Summary, describe, paired_t};
@@ -1116,37 +1117,6 @@ fn model_name(adaptive: bool) -> &'static str {
 
 // ---------------------------------------------------------------------------------------------
 // Aggregation
-
-fn col_f64(df: &DataFrame, name: &str) -> PolarsResult<Vec<f64>> {
-    Ok(df
-        .column(name)?
-        .f64()?
-        .iter()
-        .map(|v| v.unwrap_or(f64::NAN))
-        .collect())
-}
-
-fn col_opt_f64(df: &DataFrame, name: &str) -> PolarsResult<Vec<Option<f64>>> {
-    Ok(df.column(name)?.f64()?.iter().collect())
-}
-
-fn col_i64(df: &DataFrame, name: &str) -> PolarsResult<Vec<i64>> {
-    Ok(df
-        .column(name)?
-        .i64()?
-        .iter()
-        .map(|v| v.unwrap_or(0))
-        .collect())
-}
-
-fn col_str(df: &DataFrame, name: &str) -> PolarsResult<Vec<String>> {
-    Ok(df
-        .column(name)?
-        .str()?
-        .iter()
-        .map(|v| v.unwrap_or_default().to_string())
-        .collect())
-}
 
 fn session_value_i64(frames: &Frames, name: &str) -> i64 {
     frames

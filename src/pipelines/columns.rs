@@ -13,6 +13,16 @@ pub fn f64s(df: &DataFrame, name: &str) -> PolarsResult<Vec<f64>> {
         .collect())
 }
 
+/// A float column with its nulls.
+pub fn opt_f64s(df: &DataFrame, name: &str) -> PolarsResult<Vec<Option<f64>>> {
+    Ok(df
+        .column(name)?
+        .cast(&DataType::Float64)?
+        .f64()?
+        .iter()
+        .collect())
+}
+
 /// An integer column (nulls read as 0).
 pub fn i64s(df: &DataFrame, name: &str) -> PolarsResult<Vec<i64>> {
     Ok(df

@@ -25,54 +25,7 @@ use crate::run::{Aggregate, Products};
 /// Frame numbers and identities of session `s` are offset by `s · STRIDE`.
 const STRIDE: i64 = 1_000_000_000;
 
-pub(super) fn f64s(df: &DataFrame, name: &str) -> anyhow::Result<Vec<f64>> {
-    Ok(df
-        .column(name)
-        .map_err(|e| anyhow::anyhow!("column {name}: {e}"))?
-        .f64()?
-        .iter()
-        .map(|v| v.unwrap_or(f64::NAN))
-        .collect())
-}
-
-pub(super) fn opt_f64s(df: &DataFrame, name: &str) -> anyhow::Result<Vec<Option<f64>>> {
-    Ok(df
-        .column(name)
-        .map_err(|e| anyhow::anyhow!("column {name}: {e}"))?
-        .f64()?
-        .iter()
-        .collect())
-}
-
-pub(super) fn i64s(df: &DataFrame, name: &str) -> anyhow::Result<Vec<i64>> {
-    Ok(df
-        .column(name)
-        .map_err(|e| anyhow::anyhow!("column {name}: {e}"))?
-        .i64()?
-        .iter()
-        .map(|v| v.unwrap_or(0))
-        .collect())
-}
-
-pub(super) fn strs(df: &DataFrame, name: &str) -> anyhow::Result<Vec<String>> {
-    Ok(df
-        .column(name)
-        .map_err(|e| anyhow::anyhow!("column {name}: {e}"))?
-        .str()?
-        .iter()
-        .map(|v| v.unwrap_or_default().to_string())
-        .collect())
-}
-
-pub(super) fn bools(df: &DataFrame, name: &str) -> anyhow::Result<Vec<bool>> {
-    Ok(df
-        .column(name)
-        .map_err(|e| anyhow::anyhow!("column {name}: {e}"))?
-        .bool()?
-        .iter()
-        .map(|v| v.unwrap_or(false))
-        .collect())
-}
+pub(super) use crate::pipelines::columns::{bools, f64s, i64s, opt_f64s, strs};
 
 /// The tracks table of one session, by column.
 #[derive(Debug, Clone, Default)]
