@@ -67,13 +67,23 @@ pub struct Params {
     pub gabor_sigma_px: f64,
     pub gabor_wavelength_px: f64,
     pub mad_k: f64,
+    /// Frames, spread evenly over the log, whose per-pixel median starts the background
+    /// (0: the first frame, as eq. 2 alone would).
+    pub bootstrap_frames: usize,
     // §3 detection
     pub person_height_m: f64,
     pub template_scales: usize,
     pub template_tilts: usize,
     pub template_threshold: f64,
+    /// Fraction of a template window the silhouette fills (a background margin is added
+    /// around it; 1 = the silhouette's tight box).
+    pub template_fill: f64,
+    /// Try at each head position only the template the calibration predicts there
+    /// (`vision::template::TemplateMap`); false: all templates everywhere.
+    pub templates_by_position: bool,
     pub template_stride_px: u32,
     pub nms_iou: f64,
+    pub nms_contained: f64,
     // §4 2-D tracking
     pub match_iou_2d: f64,
     pub max_missed_2d: u32,
@@ -119,12 +129,16 @@ impl Default for Params {
             gabor_sigma_px: 2.0,
             gabor_wavelength_px: 8.0,
             mad_k: 3.0,
+            bootstrap_frames: 25,
             person_height_m: 1.75,
             template_scales: 4,
             template_tilts: 4,
             template_threshold: 0.7,
+            template_fill: 0.5,
+            templates_by_position: true,
             template_stride_px: 2,
             nms_iou: 0.3,
+            nms_contained: 0.7,
             match_iou_2d: 0.1,
             max_missed_2d: 2,
             p_th_px: 10.0,
@@ -223,6 +237,12 @@ impl Experiment for MulticamCylinders {
                     "{} is not in (0, 1) (paper: 0.6–0.75)",
                     p.template_threshold
                 ),
+            );
+        }
+        if !(p.template_fill > 0.0 && p.template_fill <= 1.0) {
+            bad(
+                "template_fill",
+                format!("{} is not a fraction in (0, 1]", p.template_fill),
             );
         }
         if p.template_scales == 0

@@ -19,7 +19,10 @@
 //! rows (rayon; each row is computed independently, so results do not depend on threads).
 //!
 //! The background `B` is a running average of the feature images `M` (eq. 2,
-//! `Bᵗ = (1 − α) Bᵗ⁻¹ + α Mᵗ`, initialised with the first frame); the moving-region image is
+//! `Bᵗ = (1 − α) Bᵗ⁻¹ + α Mᵗ`, initialised with the first frame, or — the paper does not say —
+//! with the features of the per-pixel temporal median of frames sampled over the log,
+//! [`GaborBackground::bootstrap`], so that people in the first frame leave no ghost); the
+//! moving-region image is
 //! the Euclidean distance `‖Bᵗ − Mᵗ‖` per pixel, thresholded at
 //! `median + k · 1.4826 · MAD` (Median Absolute Deviation, Rosin 1999 [4]; 1.4826 makes the
 //! MAD a consistent estimate of a Gaussian σ).
@@ -440,8 +443,53 @@ impl GaborBackground {
         self.model.as_ref()
     }
 
+    /// Start the model from the features of the per-pixel, per-channel temporal median of
+    /// `frames` instead of from the first frame segmented. A person present in only a minority
+    /// of the frames is left out of the median, so the model does not start with people in it
+    /// (the paper does not say how `B⁰` is obtained; with the first frame, every person in it
+    /// leaves a ghost that eq. 2 takes ~`ln(threshold / contrast) / ln(1 − α)` frames to fade).
+    pub fn bootstrap(&mut self, frames: &[RgbImage]) -> Result<(), GaborError> {
+        let Some(first) = frames.first() else {
+            return Err(GaborError::Empty);
+        };
+        let (w, h) = first.dimensions();
+        if w == 0 || h == 0 {
+            return Err(GaborError::Empty);
+        }
+        if let Some(f) = frames.iter().find(|f| f.dimensions() != (w, h)) {
+            return Err(GaborError::SizeMismatch {
+                what: "bootstrap frame",
+                expected_w: w,
+                expected_h: h,
+                got_w: f.width(),
+                got_h: f.height(),
+            });
+        }
+        let mut median = RgbImage::new(w, h);
+        let k = frames.len();
+        median
+            .as_mut()
+            .par_chunks_mut(3 * w as usize)
+            .enumerate()
+            .for_each(|(y, row)| {
+                let mut v: Vec<u8> = Vec::with_capacity(k);
+                let off = y * 3 * w as usize;
+                for (i, out) in row.iter_mut().enumerate() {
+                    v.clear();
+                    v.extend(frames.iter().map(|f| f.as_raw()[off + i]));
+                    v.sort_unstable();
+                    // lower median for an even count: a value that was really observed
+                    *out = v[(k - 1) / 2];
+                }
+            });
+        let mut model = Features::default();
+        self.bank.features(&median, &mut model, &mut self.scratch)?;
+        self.model = Some(model);
+        Ok(())
+    }
+
     /// Segment one frame into `mask` and update the background. The first frame initialises
-    /// the model and gives an empty mask.
+    /// the model and gives an empty mask (unless [`Self::bootstrap`] started it).
     pub fn apply(&mut self, rgb: &RgbImage, mask: &mut Mask) -> Result<Segmentation, GaborError> {
         let (w, h) = rgb.dimensions();
         if let Some(m) = &self.model
@@ -669,5 +717,53 @@ mod tests {
         assert_eq!(mask.get(20, 16), 1);
         assert_eq!(mask.get(1, 1), 0);
         assert_eq!(mask.get(38, 28), 0);
+    }
+    #[test]
+    fn bootstrap_leaves_out_a_person_present_in_a_minority_of_frames() {
+        let (w, h) = (36u32, 28u32);
+        let bg = RgbImage::from_fn(w, h, |x, y| {
+            image::Rgb([
+                (100 + x * 3) as u8,
+                (90 + y * 4) as u8,
+                ((x * y) % 50 + 60) as u8,
+            ])
+        });
+        // a "person" square in 2 of 5 frames, at two places
+        let with_square = |x0: u32| {
+            let mut o = bg.clone();
+            for y in 8..20 {
+                for x in x0..x0 + 8 {
+                    o.put_pixel(x, y, image::Rgb([20, 40, 220]));
+                }
+            }
+            o
+        };
+        let frames = vec![
+            bg.clone(),
+            with_square(4),
+            bg.clone(),
+            with_square(20),
+            bg.clone(),
+        ];
+        let bank = GaborBank::new(GaborParams::default()).expect("bank");
+        let mut booted = GaborBackground::new(bank.clone(), 0.02, 3.0).expect("model");
+        booted.bootstrap(&frames).expect("bootstrap");
+        // the model is exactly the features of the empty background
+        let mut want = Features::default();
+        bank.features(&bg, &mut want, &mut Scratch::default())
+            .expect("features");
+        assert_eq!(booted.model(), Some(&want));
+        // so the first frame with the square is segmented at once (the first-frame start
+        // would give an empty mask and keep the square as a ghost)
+        let mut mask = Mask::default();
+        let s = booted.apply(&with_square(4), &mut mask).expect("frame");
+        assert!(s.foreground > 50, "{s:?}");
+        assert_eq!(mask.get(8, 14), 1);
+        // errors: nothing, or frames of different sizes
+        assert_eq!(booted.bootstrap(&[]), Err(GaborError::Empty));
+        assert!(matches!(
+            booted.bootstrap(&[bg.clone(), RgbImage::new(10, 10)]),
+            Err(GaborError::SizeMismatch { .. })
+        ));
     }
 }

@@ -16,13 +16,25 @@
 //! that templates of different sizes compare):
 //! `MSE = (|T| − 2 Σ T·S + Σ S) / A`, evaluated in O(rows) with per-row prefix sums (each
 //! silhouette row is one run of pixels). The detector reports the **matching score**
-//! `1 − MSE` ∈ [0, 1]; an empty window scores `1 − |T|/A` ≈ 0.5 and a perfect match 1. The
+//! `1 − MSE` ∈ [0, 1]; an empty window scores `1 − |T|/A`, a completely filled one `|T|/A`
+//! and a perfect match 1.
+//!
+//! **Window margin.** In the silhouette's tight bounding box the profile fills
+//! `|T|/A ≈ 0.71` of the window, so *any* region of foreground larger than a person (a trail
+//! left by the running-average background, a group) scores ≈ 0.71 everywhere inside it — above
+//! every threshold in the paper's range — and the detector tiles it with detections (measured:
+//! 67–115 per camera and frame on `multicam_office`). [`Silhouette::padded`] grows the window
+//! by a background margin until the silhouette fills a chosen fraction of it; at 0.5 (the
+//! default of the pipeline) an empty and a filled window both score 0.5, as far below the
+//! threshold as they can both be. The paper calls its templates "normalized human silhouettes"
+//! and does not give the window's proportions. Detections report the silhouette's own box. The
 //! paper thresholds its combined matching image in (0.6, 0.75) with "a high threshold value"
 //! rejecting shadows: that reads as a threshold on this similarity, which is how it is used
 //! here. The minimum error over templates at each position is the maximum score; its local
 //! extrema are kept by greedy non-maximum suppression in the image (a candidate survives if
-//! its box overlaps no better one by more than `nms_iou`), the paper's non-minimal
-//! suppression. Placements may hang over the image border (at least `min_inside` of the
+//! its box overlaps no better one by more than `nms_iou` and lies no more than
+//! `nms_contained` inside one — a smaller template nested in a larger one has a small IoU),
+//! the paper's non-minimal suppression. Placements may hang over the image border (at least `min_inside` of the
 //! window inside, the head row inside); only the inside part is compared. A placement whose
 //! score cannot reach the threshold (bound `1 − |Σ T − Σ S| / A` from the window sum) is
 //! skipped without correlating.
@@ -83,6 +95,9 @@ pub struct Silhouette {
     /// Widest run (shoulders): the body width in pixels.
     pub body_width_px: f64,
     pub tilt_rad: f64,
+    /// The silhouette's own bounding box `[x0, y0, x1, y1)` in template coordinates: the
+    /// whole window unless [`Silhouette::padded`] added a background margin.
+    pub body: [u32; 4],
 }
 
 impl Silhouette {
@@ -107,15 +122,61 @@ impl Silhouette {
             .collect();
         let area = spans.iter().map(|(a, b)| b - a).sum();
         let body_width_px = spans.iter().map(|(a, b)| b - a).max().unwrap_or(1) as f64;
+        let width = (max_b - min_a).max(1) as u32;
         Silhouette {
-            width: (max_b - min_a).max(1) as u32,
+            width,
             height: rows as u32,
             area,
             head: (hgt * lean - min_a as f64, 0.0),
             spans,
             body_width_px,
             tilt_rad,
+            body: [0, 0, width, rows as u32],
         }
+    }
+
+    /// Fraction of the window inside the silhouette, `|T| / A`.
+    pub fn fill(&self) -> f64 {
+        f64::from(self.area) / (f64::from(self.width) * f64::from(self.height))
+    }
+
+    /// The same silhouette in a window grown evenly on all four sides (background margin) until
+    /// the silhouette fills at most `fill` of it. Unchanged when it already does.
+    pub fn padded(self, fill: f64) -> Silhouette {
+        if !(fill > 0.0 && fill < self.fill()) {
+            return self;
+        }
+        let (w, h) = (f64::from(self.width), f64::from(self.height));
+        let s = (self.fill() / fill).sqrt();
+        let pad_x = ((w * s - w) / 2.0).ceil() as u32;
+        let pad_y = ((h * s - h) / 2.0).ceil() as u32;
+        let mut spans = Vec::with_capacity(self.spans.len() + 2 * pad_y as usize);
+        spans.extend(std::iter::repeat_n((0, 0), pad_y as usize));
+        spans.extend(self.spans.iter().map(|&(a, b)| (a + pad_x, b + pad_x)));
+        spans.extend(std::iter::repeat_n((0, 0), pad_y as usize));
+        Silhouette {
+            width: self.width + 2 * pad_x,
+            height: self.height + 2 * pad_y,
+            spans,
+            area: self.area,
+            head: (
+                self.head.0 + f64::from(pad_x),
+                self.head.1 + f64::from(pad_y),
+            ),
+            body_width_px: self.body_width_px,
+            tilt_rad: self.tilt_rad,
+            body: [
+                self.body[0] + pad_x,
+                self.body[1] + pad_y,
+                self.body[2] + pad_x,
+                self.body[3] + pad_y,
+            ],
+        }
+    }
+
+    /// Height of the silhouette itself (pixels), without margins.
+    pub fn body_height_px(&self) -> f64 {
+        f64::from(self.body[3] - self.body[1])
     }
 }
 
@@ -215,6 +276,115 @@ pub fn calibrated_templates(
     Ok(out)
 }
 
+/// The template tried at each head pixel of one camera: the calibration predicts the image
+/// height and tilt of a person `person_height_m` tall whose head is at that pixel (the ray
+/// through it meets the plane at head height over the room floor; the feet below project back
+/// into the image), and the template nearest in height (log ratio), then in tilt, is the one
+/// correlated there. Pixels whose head point falls outside the room (± margin) or that the
+/// camera cannot place get none. This is the paper's "the range of the scale and the 3D
+/// orientation of the human silhouettes can be restricted according to the camera position
+/// and size of the room" applied per position instead of per image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TemplateMap {
+    width: u32,
+    height: u32,
+    choice: Vec<u16>,
+}
+
+impl TemplateMap {
+    const NONE: u16 = u16::MAX;
+
+    pub fn new(
+        view: &CalibratedView,
+        templates: &[Silhouette],
+        person_height_m: f64,
+        room_m: [f64; 4],
+        margin_m: f64,
+    ) -> TemplateMap {
+        let (width, height) = view.model.size();
+        let mut choice = vec![Self::NONE; width as usize * height as usize];
+        for y in 0..height {
+            for x in 0..width {
+                let px = nalgebra::Point2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                let Some(a) = expected_appearance(view, &px, person_height_m, room_m, margin_m)
+                else {
+                    continue;
+                };
+                let best = templates
+                    .iter()
+                    .enumerate()
+                    .map(|(i, t)| {
+                        (
+                            (t.body_height_px() / a.height_px).ln().abs(),
+                            (t.tilt_rad - a.tilt_rad).abs(),
+                            i,
+                        )
+                    })
+                    .min_by(|p, q| {
+                        // heights equal to a micro-pixel are one scale: the tilt decides
+                        let dh = p.0 - q.0;
+                        if dh.abs() > 1e-9 {
+                            dh.total_cmp(&0.0)
+                        } else {
+                            p.1.total_cmp(&q.1).then(p.2.cmp(&q.2))
+                        }
+                    });
+                if let Some((_, _, i)) = best {
+                    choice[(y * width + x) as usize] = i as u16;
+                }
+            }
+        }
+        TemplateMap {
+            width,
+            height,
+            choice,
+        }
+    }
+
+    /// The template index to try with the head at pixel `(x, y)`, if any.
+    pub fn at(&self, x: i64, y: i64) -> Option<usize> {
+        if x < 0 || y < 0 || x >= i64::from(self.width) || y >= i64::from(self.height) {
+            return None;
+        }
+        let c = self.choice[(y as u32 * self.width + x as u32) as usize];
+        (c != Self::NONE).then_some(usize::from(c))
+    }
+}
+
+/// Image height and tilt of a person `person_height_m` tall whose head is seen at `head_px`,
+/// or `None` when that head would stand outside the room (± `margin_m`) or is not in front of
+/// the camera.
+pub fn expected_appearance(
+    view: &CalibratedView,
+    head_px: &nalgebra::Point2<f64>,
+    person_height_m: f64,
+    room_m: [f64; 4],
+    margin_m: f64,
+) -> Option<Appearance> {
+    let (o, d) = view.ray_in_world(head_px)?;
+    if d.z.abs() < 1e-9 {
+        return None;
+    }
+    let t = (person_height_m - o.z) / d.z;
+    if t <= 0.0 {
+        return None;
+    }
+    let head = o + d * t;
+    if head.x < room_m[0] - margin_m
+        || head.x > room_m[2] + margin_m
+        || head.y < room_m[1] - margin_m
+        || head.y > room_m[3] + margin_m
+    {
+        return None;
+    }
+    let foot = view.project(&Point3::new(head.x, head.y, 0.0))?;
+    let (dx, dy) = (head_px.x - foot.x, foot.y - head_px.y);
+    (dy > 0.0).then(|| Appearance {
+        height_px: dx.hypot(dy),
+        tilt_rad: dx.atan2(dy),
+    })
+}
+
 /// Detector settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DetectorParams {
@@ -225,6 +395,9 @@ pub struct DetectorParams {
     /// Greedy non-maximum suppression: a candidate whose box overlaps a better detection by
     /// more than this IoU is dropped.
     pub nms_iou: f64,
+    /// A candidate whose box lies more than this fraction inside a better detection's box is
+    /// dropped too (a smaller template nested in a larger one has a small IoU with it).
+    pub nms_contained: f64,
     /// Fraction of a template window that must lie inside the image.
     pub min_inside: f64,
 }
@@ -235,6 +408,7 @@ impl Default for DetectorParams {
             threshold: 0.7,
             stride_px: 2,
             nms_iou: 0.3,
+            nms_contained: 0.7,
             min_inside: 0.5,
         }
     }
@@ -243,7 +417,8 @@ impl Default for DetectorParams {
 /// One detected person.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Detection {
-    /// `[x0, y0, x1, y1]` of the template window (may reach outside the image).
+    /// `[x0, y0, x1, y1]` of the silhouette (the template window without its margin; may reach
+    /// outside the image).
     pub bbox: [f64; 4],
     /// Top of the head (pixels).
     pub head_px: [f64; 2],
@@ -317,7 +492,8 @@ fn score_at(
         (x + i64::from(t.width)).min(w),
         (y + i64::from(t.height)).min(h),
     );
-    if x1 <= x0 || y1 <= y0 || y < 0 || y >= h {
+    let head_row = y + t.head.1 as i64;
+    if x1 <= x0 || y1 <= y0 || head_row < 0 || head_row >= h {
         return None;
     }
     let area = ((x1 - x0) * (y1 - y0)) as f64;
@@ -364,38 +540,59 @@ fn iou(a: &[f64; 4], b: &[f64; 4]) -> f64 {
     inter / (area(a) + area(b) - inter)
 }
 
-/// Detect people in a foreground mask with a template set.
+/// Fraction of box `a`'s area inside box `b`.
+fn contained(a: &[f64; 4], b: &[f64; 4]) -> f64 {
+    let iw = (a[2].min(b[2]) - a[0].max(b[0])).max(0.0);
+    let ih = (a[3].min(b[3]) - a[1].max(b[1])).max(0.0);
+    let area = (a[2] - a[0]) * (a[3] - a[1]);
+    if area <= 0.0 { 0.0 } else { iw * ih / area }
+}
+
+/// Detect people in a foreground mask with a template set, every template at every position.
 pub fn detect(mask: &Mask, templates: &[Silhouette], p: &DetectorParams) -> Vec<Detection> {
+    detect_with(mask, templates, None, p)
+}
+
+/// Detect people, trying at each head position only the template `map` chooses there (all
+/// of them without a map).
+pub fn detect_with(
+    mask: &Mask,
+    templates: &[Silhouette],
+    map: Option<&TemplateMap>,
+    p: &DetectorParams,
+) -> Vec<Detection> {
     if mask.width == 0 || mask.height == 0 || templates.is_empty() {
         return Vec::new();
     }
     let sums = Sums::new(mask);
     let (w, h) = (i64::from(mask.width), i64::from(mask.height));
     let stride = i64::from(p.stride_px.max(1));
-    // best score per position over templates (the paper's minimum of the MSE images)
+    // best score per head position over templates (the paper's minimum of the MSE images);
+    // positions are anchored at the head so that every template shares one grid
     let mut best: std::collections::BTreeMap<(i64, i64), (f64, usize)> = Default::default();
     for (ti, t) in templates.iter().enumerate() {
-        let (tw, th) = (i64::from(t.width), i64::from(t.height));
-        // positions are anchored at the head so that every template shares one grid
-        let hx = t.head.0.round() as i64;
-        let mut y = 0;
-        while y < h {
+        let tw = i64::from(t.width);
+        let (hx, hy) = (t.head.0.round() as i64, t.head.1.round() as i64);
+        let mut yh = 0;
+        while yh < h {
+            let y = yh - hy;
             let mut xh = -tw / 2 + hx;
             while xh < w + tw / 2 {
                 let x = xh - hx;
-                if x + tw > 0
+                let allowed = map.is_none_or(|m| m.at(xh, yh) == Some(ti));
+                if allowed
+                    && x + tw > 0
                     && let Some(s) = score_at(&sums, t, x, y, p.threshold, p.min_inside)
                     && s >= p.threshold
                 {
-                    let e = best.entry((xh, y)).or_insert((f64::NEG_INFINITY, 0));
+                    let e = best.entry((xh, yh)).or_insert((f64::NEG_INFINITY, 0));
                     if s > e.0 {
                         *e = (s, ti);
                     }
                 }
                 xh += stride;
             }
-            y += stride;
-            let _ = th;
+            yh += stride;
         }
     }
     let mut cands: Vec<(f64, i64, i64, usize)> = best
@@ -410,12 +607,16 @@ pub fn detect(mask: &Mask, templates: &[Silhouette], p: &DetectorParams) -> Vec<
             .then(a.3.cmp(&b.3))
     });
     let mut out: Vec<Detection> = Vec::new();
-    for (score, y, xh, ti) in cands {
+    for (score, yh, xh, ti) in cands {
         let t = &templates[ti];
         let x = (xh - t.head.0.round() as i64) as f64;
-        let y = y as f64;
-        let bbox = [x, y, x + f64::from(t.width), y + f64::from(t.height)];
-        if out.iter().any(|d| iou(&d.bbox, &bbox) > p.nms_iou) {
+        let y = (yh - t.head.1.round() as i64) as f64;
+        let b = t.body.map(f64::from);
+        let bbox = [x + b[0], y + b[1], x + b[2], y + b[3]];
+        if out
+            .iter()
+            .any(|d| iou(&d.bbox, &bbox) > p.nms_iou || contained(&bbox, &d.bbox) > p.nms_contained)
+        {
             continue;
         }
         let head_px = [x + t.head.0, y + t.head.1];
@@ -424,7 +625,7 @@ pub fn detect(mask: &Mask, templates: &[Silhouette], p: &DetectorParams) -> Vec<
             head_px,
             centroid_px: centroid(mask, &bbox).unwrap_or(head_px),
             width_px: t.body_width_px,
-            height_px: f64::from(t.height),
+            height_px: t.body_height_px(),
             score,
             template: ti,
         });
@@ -545,6 +746,98 @@ mod tests {
         let sums = Sums::new(&full);
         let s = score_at(&sums, &t, 10, 5, 0.0, 0.5).expect("allowed");
         assert!((s - f64::from(t.area) / f64::from(t.width * t.height)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_padded_template_finds_the_silhouette_and_ignores_filled_regions() {
+        let tight = Silhouette::new(60.0, 0.1);
+        let t = tight.clone().padded(0.5);
+        // the margin brings the fill to the target (rounding up the margins: at most 0.5)
+        assert!(tight.fill() > 0.65, "{}", tight.fill());
+        assert!(t.fill() <= 0.5 && t.fill() > 0.45, "{}", t.fill());
+        assert_eq!(t.area, tight.area);
+        assert_eq!(
+            t.body_height_px(),
+            f64::from(tight.height),
+            "the body box is the tight silhouette"
+        );
+        // painted with the tight silhouette, found with the padded one: score 1, tight box
+        let mut mask = Mask::new(140, 110);
+        paint(&mut mask, &tight, 41, 24);
+        let p = DetectorParams {
+            stride_px: 1,
+            ..Default::default()
+        };
+        let dets = detect(&mask, std::slice::from_ref(&t), &p);
+        assert_eq!(dets.len(), 1, "{dets:?}");
+        assert!((dets[0].score - 1.0).abs() < 1e-12);
+        assert_eq!(
+            dets[0].bbox,
+            [41.0, 24.0, 41.0 + f64::from(tight.width), 24.0 + 60.0]
+        );
+        assert!((dets[0].head_px[0] - (41.0 + tight.head.0)).abs() < 1e-9);
+        assert_eq!(dets[0].head_px[1], 24.0);
+        // a completely filled window scores its fill: the tight box (≈ 0.71) passes the
+        // paper's threshold on any large blob, the padded one (≤ 0.5) never does
+        let full = Mask {
+            width: 140,
+            height: 110,
+            data: vec![1; 140 * 110],
+        };
+        let sums = Sums::new(&full);
+        let s = score_at(&sums, &t, 30, 20, 0.0, 0.5).expect("allowed");
+        assert!((s - t.fill()).abs() < 1e-12);
+        assert!(detect(&full, std::slice::from_ref(&t), &p).is_empty());
+        assert!(!detect(&full, std::slice::from_ref(&tight), &p).is_empty());
+        // unchanged when the target is not below the fill
+        assert_eq!(tight.clone().padded(0.9), tight);
+    }
+
+    fn corner_view() -> CalibratedView {
+        use crate::geometry::camera::{CameraModel, Pinhole};
+        let mut pin = Pinhole::from_fov(352, 288, 78.0);
+        pin.dist = [-0.24, 0.06, 0.0, 0.0, 0.0];
+        CalibratedView::new(
+            CameraModel::Pinhole(pin),
+            crate::geometry::look_at(Point3::new(0.15, 0.15, 2.85), Point3::new(4.0, 4.25, 0.7)),
+        )
+    }
+
+    #[test]
+    fn the_position_map_predicts_the_projected_height_of_a_person() {
+        let view = corner_view();
+        let room = [0.0, 0.0, 8.0, 8.5];
+        let mut checked = 0;
+        for &(x, y) in &[(1.5, 2.0), (4.0, 4.0), (6.5, 7.5), (2.0, 6.0), (7.0, 1.5)] {
+            let head = view.project(&Point3::new(x, y, 1.75)).expect("head");
+            let foot = view.project(&Point3::new(x, y, 0.0)).expect("foot");
+            let a = expected_appearance(&view, &head, 1.75, room, 0.5).expect("in the room");
+            let want = (head.x - foot.x).hypot(foot.y - head.y);
+            assert!((a.height_px - want).abs() < 1e-6 * want, "{a:?} vs {want}");
+            assert!((a.tilt_rad - (head.x - foot.x).atan2(foot.y - head.y)).abs() < 1e-9);
+            checked += 1;
+        }
+        assert_eq!(checked, 5);
+        // a head outside the room (behind the wall, past the margin) gets none
+        let out = view
+            .project(&Point3::new(9.5, 4.0, 1.75))
+            .expect("projects");
+        assert!(expected_appearance(&view, &out, 1.75, room, 0.5).is_none());
+        // the map picks, at a head pixel, the template nearest in height
+        let templates: Vec<Silhouette> = [40.0, 60.0, 90.0, 135.0]
+            .iter()
+            .map(|&h| Silhouette::new(h, 0.0).padded(0.5))
+            .collect();
+        let map = TemplateMap::new(&view, &templates, 1.75, room, 0.5);
+        let head = view.project(&Point3::new(4.0, 4.0, 1.75)).expect("head");
+        let a = expected_appearance(&view, &head, 1.75, room, 0.5).expect("a");
+        let want = (0..4)
+            .min_by(|&i, &j| {
+                let d = |k: usize| (templates[k].body_height_px() / a.height_px).ln().abs();
+                d(i).total_cmp(&d(j))
+            })
+            .expect("some");
+        assert_eq!(map.at(head.x as i64, head.y as i64), Some(want));
     }
 
     #[test]

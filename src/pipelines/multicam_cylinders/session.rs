@@ -113,6 +113,8 @@ struct CameraChain {
     background: GaborBackground,
     mask: Mask,
     templates: Vec<Silhouette>,
+    /// The template tried at each head position (`templates_by_position`).
+    map: Option<template::TemplateMap>,
     tracker: GraphTracker,
 }
 
@@ -305,6 +307,71 @@ fn iou(a: &[f64; 4], b: &[f64; 4]) -> f64 {
     inter / (area(a) + area(b) - inter)
 }
 
+/// A template detection matches a ground-truth person when its head point is within this many
+/// visible-box widths of the top centre of the visible box.
+pub(crate) const DETECTION_HEAD_TOL: f64 = 0.5;
+
+/// Template detections scored against the visible ground-truth boxes, one row per frame and
+/// camera; head offsets and height ratios are sums over the matched pairs.
+#[derive(Default)]
+struct Det2dCols {
+    frame: Vec<i64>,
+    camera: Vec<String>,
+    truth: Vec<i64>,
+    detections: Vec<i64>,
+    matched: Vec<i64>,
+    head_dx_abs: Vec<f64>,
+    head_dy: Vec<f64>,
+    height_ratio: Vec<f64>,
+}
+
+impl Det2dCols {
+    /// Greedy one-to-one matching by increasing head distance: a detection's head point must
+    /// lie within `head_tol` visible-box widths of the top centre of the visible box (the
+    /// point the 3-D stage triangulates; IoU would punish the full-body template box of a
+    /// person whose legs a desk hides).
+    fn push(
+        &mut self,
+        frame: usize,
+        camera: &str,
+        truth: &[Box2d],
+        dets: &[Detection],
+        head_tol: f64,
+    ) {
+        let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+        for (i, t) in truth.iter().enumerate() {
+            for (j, d) in dets.iter().enumerate() {
+                let dist = (d.head_px[0] - t.head_px[0]).hypot(d.head_px[1] - t.head_px[1]);
+                if dist <= head_tol * t.width_px {
+                    pairs.push((dist, i, j));
+                }
+            }
+        }
+        pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
+        let (mut used_t, mut used_d) = (vec![false; truth.len()], vec![false; dets.len()]);
+        let (mut n, mut dx, mut dy, mut hr) = (0i64, 0.0, 0.0, 0.0);
+        for (_, i, j) in pairs {
+            if used_t[i] || used_d[j] {
+                continue;
+            }
+            used_t[i] = true;
+            used_d[j] = true;
+            n += 1;
+            dx += (dets[j].head_px[0] - truth[i].head_px[0]).abs();
+            dy += dets[j].head_px[1] - truth[i].head_px[1];
+            hr += dets[j].height_px / truth[i].height_px.max(1.0);
+        }
+        self.frame.push(frame as i64);
+        self.camera.push(camera.to_string());
+        self.truth.push(truth.len() as i64);
+        self.detections.push(dets.len() as i64);
+        self.matched.push(n);
+        self.head_dx_abs.push(dx);
+        self.head_dy.push(dy);
+        self.height_ratio.push(hr);
+    }
+}
+
 /// `(head, centroid)` per person and camera, associated greedily by IoU with the truth.
 #[allow(clippy::too_many_arguments)]
 fn head_centroid_frame(
@@ -390,6 +457,69 @@ fn head_centroid_frame(
     }
 }
 
+/// Up to `n` images per camera topic, evenly spread over the log (the message counts of the
+/// summary pick which), for [`GaborBackground::bootstrap`]. Undecodable ones are skipped here:
+/// the main pass counts and reports them.
+fn bootstrap_images(
+    log: &SessionLog,
+    topics: &[String],
+    n: usize,
+) -> anyhow::Result<Vec<Vec<RgbImage>>> {
+    let mut out: Vec<Vec<RgbImage>> = vec![Vec::new(); topics.len()];
+    if n == 0 {
+        return Ok(out);
+    }
+    let counts: Vec<u64> = topics
+        .iter()
+        .map(|tp| {
+            let ch = log.summary().channel(tp);
+            log.summary()
+                .statistics
+                .as_ref()
+                .zip(ch)
+                .and_then(|(st, ch)| st.channel_message_counts.get(&ch.id).copied())
+                .unwrap_or(0)
+        })
+        .collect();
+    let present: Vec<&str> = topics
+        .iter()
+        .map(String::as_str)
+        .filter(|tp| log.summary().channel(tp).is_some())
+        .collect();
+    if present.is_empty() {
+        return Ok(out);
+    }
+    let mut seen = vec![0u64; topics.len()];
+    let mut decoders = Decoders::new();
+    for m in log.messages_on(&present)? {
+        let m = m?;
+        let Some(c) = topics.iter().position(|tp| tp == m.topic()) else {
+            continue;
+        };
+        let k = seen[c];
+        seen[c] += 1;
+        // message k is taken when it is the first at or after j · count / n for some j
+        let step = (counts[c] / n as u64).max(1);
+        if !k.is_multiple_of(step) || out[c].len() >= n {
+            continue;
+        }
+        let payload = match m.channel.schema_name() {
+            "sensor_msgs/msg/Image" | "foxglove.RawImage" => {
+                decoders.typed::<Image>(log, &m).map(Payload::Raw)
+            }
+            _ => decoders
+                .typed::<CompressedImage>(log, &m)
+                .map(Payload::Compressed),
+        };
+        if let Ok(p) = payload
+            && let Some(Ok(rgb)) = decode_image(&p)
+        {
+            out[c].push(rgb);
+        }
+    }
+    Ok(out)
+}
+
 pub(crate) fn process(
     s: &Session,
     p: &Params,
@@ -412,7 +542,14 @@ pub(crate) fn process(
         threshold: p.template_threshold,
         stride_px: p.template_stride_px,
         nms_iou: p.nms_iou,
+        nms_contained: p.nms_contained,
         ..DetectorParams::default()
+    };
+    let boot = if use_images {
+        bar.set_message("background bootstrap");
+        bootstrap_images(log, &t.image, p.bootstrap_frames)?
+    } else {
+        Vec::new()
     };
     let mut chains: Vec<CameraChain> = Vec::with_capacity(n_cams);
     for (c, view) in calib.views.iter().enumerate() {
@@ -425,11 +562,32 @@ pub(crate) fn process(
                 p.template_tilts,
             )
             .with_context(|| format!("{file}: templates of camera {}", p.cameras[c]))?
+            .into_iter()
+            .map(|t| t.padded(p.template_fill))
+            .collect()
         } else {
             Vec::new()
         };
+        let mut background = GaborBackground::new(bank.clone(), p.alpha, p.mad_k)?;
+        if let Some(frames) = boot.get(c)
+            && !frames.is_empty()
+        {
+            background.bootstrap(frames).with_context(|| {
+                format!("{file}: background bootstrap of camera {}", p.cameras[c])
+            })?;
+        }
+        let map = (use_images && p.templates_by_position).then(|| {
+            template::TemplateMap::new(
+                view,
+                &templates,
+                p.person_height_m,
+                p.room_m,
+                p.room_margin_m,
+            )
+        });
         chains.push(CameraChain {
-            background: GaborBackground::new(bank.clone(), p.alpha, p.mad_k)?,
+            map,
+            background,
             mask: Mask::default(),
             templates,
             tracker: GraphTracker::new(graph_params(p, 0.04)),
@@ -522,9 +680,10 @@ pub(crate) fn process(
                                     out.threshold = seg.threshold;
                                     out.foreground_frac = seg.foreground as f64
                                         / (f64::from(rgb.width()) * f64::from(rgb.height()));
-                                    out.detections = template::detect(
+                                    out.detections = template::detect_with(
                                         &chain.mask,
                                         &chain.templates,
+                                        chain.map.as_ref(),
                                         &det_params,
                                     );
                                     out.detections
@@ -897,6 +1056,26 @@ pub(crate) fn process(
         }
     }
 
+    // the template detections against the visible ground-truth boxes, per frame and camera
+    let mut d2 = Det2dCols::default();
+    if use_images {
+        for (k, gt) in gt_for_frame.iter().enumerate() {
+            let Some(gt) = gt else { continue };
+            for (c, cam) in p.cameras.iter().enumerate() {
+                let truth_boxes: Vec<Box2d> = boxes_from_truth(gt, cam)
+                    .into_iter()
+                    .map(|(_, b)| b)
+                    .collect();
+                let dets = frames[k]
+                    .detections
+                    .get(c)
+                    .map(Vec::as_slice)
+                    .unwrap_or(&[]);
+                d2.push(k, cam, &truth_boxes, dets, DETECTION_HEAD_TOL);
+            }
+        }
+    }
+
     let tracks_df = df! {
         "detector" => tc.detector, "selection" => tc.selection, "n_app" => tc.n_app,
         "frame" => tc.frame, "stamp_ns" => tc.stamp_ns, "t_s" => tc.t_s, "id" => tc.id,
@@ -914,6 +1093,11 @@ pub(crate) fn process(
         "detector" => hc.detector, "frame" => hc.frame, "id" => hc.id, "cameras" => hc.cameras,
         "occluded" => hc.occluded, "clear" => hc.clear, "min_visibility" => hc.min_visibility,
         "head_error_m" => hc.head_error_m, "centroid_error_m" => hc.centroid_error_m,
+    }?;
+    let det2d_df = df! {
+        "frame" => d2.frame, "camera" => d2.camera, "truth" => d2.truth,
+        "detections" => d2.detections, "matched" => d2.matched, "head_dx_abs_px" => d2.head_dx_abs,
+        "head_dy_px" => d2.head_dy, "height_ratio" => d2.height_ratio,
     }?;
     let cams_df = df! {
         "frame" => cam_rows.0, "camera" => cam_rows.1, "threshold" => cam_rows.2,
@@ -956,6 +1140,7 @@ pub(crate) fn process(
         ("gt".to_string(), gt_df),
         ("head_centroid".to_string(), hc_df),
         ("cameras".to_string(), cams_df),
+        ("detections_2d".to_string(), det2d_df),
         ("variants".to_string(), variants_df),
         ("session".to_string(), session_df),
     ]))
