@@ -1202,8 +1202,10 @@ fn by_dataset<'a>(ctx: &'a Aggregate) -> Vec<(String, Vec<&'a Frames>)> {
 /// the first error, which names the file, topic and log time), and a summary line for every
 /// session that skipped any.
 fn input_products(ctx: &Aggregate, products: &mut Products) -> anyhow::Result<()> {
-    let mut rows: (Vec<String>, Vec<String>, Vec<i64>, Vec<i64>, Vec<i64>) = Default::default();
-    let mut more: (Vec<i64>, Vec<i64>, Vec<String>) = Default::default();
+    let (mut datasets, mut names) = (Vec::new(), Vec::new());
+    let (mut n_frames, mut n_images, mut n_masks, mut n_without, mut n_gt) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut errors = Vec::new();
     for (info, frames) in ctx.sessions {
         let Some(df) = frames.get("session") else {
             continue;
@@ -1222,24 +1224,24 @@ fn input_products(ctx: &Aggregate, products: &mut Products) -> anyhow::Result<()
                 if first_error.is_empty() { "(ground truth JSON)" } else { &first_error }
             ));
         }
-        rows.0.push(info.dataset.clone());
-        rows.1.push(info.name.clone());
-        rows.2.push(v("frames"));
-        rows.3.push(bad_images);
-        rows.4.push(bad_masks);
-        more.0.push(v("frames_without_mask"));
-        more.1.push(bad_gt);
-        more.2.push(first_error);
+        datasets.push(info.dataset.clone());
+        names.push(info.name.clone());
+        n_frames.push(v("frames"));
+        n_images.push(bad_images);
+        n_masks.push(bad_masks);
+        n_without.push(v("frames_without_mask"));
+        n_gt.push(bad_gt);
+        errors.push(first_error);
     }
     products.tables.push(
         Table::new(
             "sessions",
             "Sessions read: frames and the bad messages skipped (counted, never fatal)",
             df! {
-                "dataset" => rows.0, "session" => rows.1, "frames" => rows.2,
-                "bad_images" => rows.3, "bad_masks" => rows.4,
-                "frames_without_mask" => more.0, "bad_ground_truth" => more.1,
-                "first_error" => more.2,
+                "dataset" => datasets, "session" => names, "frames" => n_frames,
+                "bad_images" => n_images, "bad_masks" => n_masks,
+                "frames_without_mask" => n_without, "bad_ground_truth" => n_gt,
+                "first_error" => errors,
             }?,
         )
         .with_note("An image or mask message that does not decode is skipped and counted (as is an unreadable ground-truth message); first_error names the file, topic and log time of the first one. A log that cannot be read, or lacks the image topic, is skipped by the runner with its reason."),
