@@ -3,13 +3,17 @@
 //! table and figure is written, known properties of the numbers (a lower c_thr can only add
 //! foreground pixels, so TP % and FP % fall as c_thr grows; the EM-like tracker follows the
 //! walker), and that every table except the timing one is byte-identical whatever the thread
-//! count.
+//! count. Bad logs: a truncated log and one without the image topic are skipped with a reason
+//! naming the file and topic, undecodable images are counted and reported in `sessions`.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
+use peopletrack::log::{SessionLog, SessionWriter, WriterOptions};
 use peopletrack::synth::{SynthOptions, synthesize};
+
+const IMAGE_TOPIC: &str = "/cam_0/image_raw/compressed";
 
 const SCENARIO: &str = r#"
 [scenario]
@@ -227,4 +231,113 @@ fn pipeline_end_to_end_on_a_tiny_scene() {
     }
     // the Wallflower folder is absent here: no table, not an error
     assert!(!a.contains_key("tables/wallflower.csv"));
+}
+
+/// A copy of `src` at `dst` without the channels on `drop_topic`; the payloads of the image
+/// messages whose index is in `cut` are cut in half (undecodable CDR).
+fn copy_log(src: &Path, dst: &Path, drop_topic: Option<&str>, cut: &[usize]) {
+    let log = SessionLog::open(src).expect("open");
+    let mut w = SessionWriter::create(dst, &WriterOptions::default()).expect("create");
+    let mut channels = BTreeMap::new();
+    for (id, ch) in &log.summary().channels {
+        if Some(ch.topic.as_str()) == drop_topic {
+            continue;
+        }
+        let schema = ch
+            .schema
+            .as_deref()
+            .map(|s| (s.name.as_str(), s.encoding.as_str(), s.data.as_slice()));
+        let out = w
+            .add_raw(&ch.topic, schema, &ch.message_encoding)
+            .expect("channel");
+        channels.insert(*id, (out, ch.topic == IMAGE_TOPIC));
+    }
+    let mut image_index = 0;
+    for m in log.messages().expect("messages") {
+        let m = m.expect("message");
+        let Some(&(ch, is_image)) = channels.get(&m.channel.id) else {
+            continue;
+        };
+        let mut data: &[u8] = &m.data;
+        if is_image {
+            if cut.contains(&image_index) {
+                data = &data[..data.len() / 2];
+            }
+            image_index += 1;
+        }
+        w.write_bytes(ch, m.log_time, data).expect("copy");
+    }
+    w.finish().expect("finish");
+}
+
+fn run_output(pipeline: &Path, sessions: &str, out: &Path) -> (bool, String) {
+    let o = Command::cargo_bin("peopletrack")
+        .expect("binary")
+        .args(["-j", "2", "run"])
+        .arg(pipeline)
+        .args(["--sessions", sessions, "--out"])
+        .arg(out)
+        .output()
+        .expect("runs");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    (o.status.success(), text)
+}
+
+#[test]
+fn bad_logs_are_skipped_or_counted_naming_file_and_topic() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = synth(dir.path());
+    let good = data.join("walk_00.mcap");
+    let toml = dir.path().join("bt.toml");
+    let missing = dir.path().join("no_wallflower");
+    std::fs::write(&toml, pipeline(&missing.to_string_lossy())).expect("write pipeline");
+    let bad = dir.path().join("bad").join("walk");
+    std::fs::create_dir_all(&bad).expect("mkdir");
+    copy_log(&good, &bad.join("no_image.mcap"), Some(IMAGE_TOPIC), &[]);
+    copy_log(&good, &bad.join("bad_jpeg.mcap"), None, &[12, 13, 20]);
+    let bytes = std::fs::read(&good).expect("read");
+    std::fs::write(bad.join("truncated.mcap"), &bytes[..bytes.len() / 2]).expect("write");
+
+    // a log without the image topic alone: the run fails, naming the file and the topic
+    let (ok, text) = run_output(
+        &toml,
+        &bad.join("no_image.mcap").to_string_lossy(),
+        &dir.path().join("o_alone"),
+    );
+    assert!(!ok, "{text}");
+    assert!(
+        text.contains("no_image") && text.contains(IMAGE_TOPIC),
+        "{text}"
+    );
+    assert!(!text.contains("panicked"), "{text}");
+
+    // all three: the truncated and the imageless logs are skipped with their reasons, the
+    // one with three broken images is processed and its skips counted and named
+    let out = dir.path().join("o_bad");
+    let (ok, text) = run_output(&toml, &format!("{}/*.mcap", bad.display()), &out);
+    assert!(ok, "{text}");
+    assert!(!text.contains("panicked"), "{text}");
+    assert!(
+        text.contains("1 computed") && text.contains("2 skipped"),
+        "{text}"
+    );
+    assert!(
+        text.contains("truncated") && text.contains("no_image"),
+        "{text}"
+    );
+    let sessions = std::fs::read_to_string(out.join("background_tracking/tables/sessions.csv"))
+        .expect("sessions table");
+    let row = sessions
+        .lines()
+        .find(|l| l.contains("bad_jpeg"))
+        .expect("bad_jpeg row");
+    assert!(row.starts_with("walk,bad_jpeg,37,3,0,"), "{sessions}");
+    assert!(
+        row.contains("bad_jpeg.mcap") && row.contains(IMAGE_TOPIC),
+        "{row}"
+    );
 }

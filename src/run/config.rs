@@ -163,6 +163,28 @@ pub struct SessionRef {
     pub path: PathBuf,
 }
 
+/// The dataset a session file belongs to: the folder holding it, or, for a profile's folder
+/// written by `peopletrack synth --profile full` (`datasets/<name>/full/`: no `scenario.toml`
+/// of its own, one in its parent), the folder above.
+fn dataset_name(file: &std::path::Path) -> String {
+    let name = |d: &std::path::Path| {
+        d.file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    };
+    let Some(folder) = file.parent() else {
+        return String::new();
+    };
+    match folder.parent() {
+        Some(up)
+            if !folder.join("scenario.toml").is_file() && up.join("scenario.toml").is_file() =>
+        {
+            name(up)
+        }
+        _ => name(folder),
+    }
+}
+
 /// Expand globs (sorted, without repeats), drop excluded names, name each session.
 pub fn find_sessions(
     patterns: &[String],
@@ -197,11 +219,7 @@ pub fn find_sessions(
             {
                 continue;
             }
-            let dataset = p
-                .parent()
-                .and_then(|d| d.file_name())
-                .map(|d| d.to_string_lossy().into_owned())
-                .unwrap_or_default();
+            let dataset = dataset_name(&p);
             let name = file.strip_suffix(".mcap").unwrap_or(&file).to_string();
             out.push(SessionRef {
                 dataset,
@@ -262,6 +280,36 @@ mod tests {
             .expect_err("missing")
             .to_string();
         assert!(e.contains("title"), "{e}");
+    }
+
+    /// Regression: full-profile logs (`datasets/<name>/full/*.mcap`) were all named dataset
+    /// `full`, merging every dataset's per-dataset tables and defeating dataset filters.
+    #[test]
+    fn full_profile_sessions_keep_their_dataset_name() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        for f in [
+            "walker/scenario.toml",
+            "walker/full/walker_00.mcap",
+            "mine/full/x.mcap",
+        ] {
+            let p = dir.path().join(f);
+            std::fs::create_dir_all(p.parent().expect("parent")).expect("mkdir");
+            std::fs::write(&p, b"x").expect("write");
+        }
+        let pat = format!("{}/*/full/*.mcap", dir.path().display());
+        let s = find_sessions(&[pat], &[]).expect("globs");
+        let names: Vec<(String, String)> = s
+            .iter()
+            .map(|s| (s.dataset.clone(), s.name.clone()))
+            .collect();
+        // a user's folder named `full` without a scenario above it keeps its name
+        assert_eq!(
+            names,
+            vec![
+                ("full".into(), "x".into()),
+                ("walker".into(), "walker_00".into())
+            ]
+        );
     }
 
     #[test]

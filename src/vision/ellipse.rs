@@ -138,8 +138,31 @@ impl Ellipse {
     /// Intersection over union of the [`SHAPE_SIGMA`] (2σ) regions of two ellipses, counted on
     /// a half-pixel grid over their joint bounding box; 0 when either is degenerate.
     pub fn overlap(&self, other: &Ellipse) -> f64 {
+        let (inter, _, union) = self.sampled_intersection(other);
+        if union == 0 {
+            0.0
+        } else {
+            inter as f64 / union as f64
+        }
+    }
+
+    /// Fraction of this ellipse's 2σ region that lies inside `other`'s 2σ region (0 when
+    /// degenerate), sampled as [`Self::overlap`]. Unlike the IoU it does not penalise `other`
+    /// for being larger: a region that settles inside an object is fully covered by the
+    /// object's moment ellipse.
+    pub fn covered_by(&self, other: &Ellipse) -> f64 {
+        let (inter, own, _) = self.sampled_intersection(other);
+        if own == 0 {
+            0.0
+        } else {
+            inter as f64 / own as f64
+        }
+    }
+
+    /// Samples in both 2σ regions, in this one, and in either (grid of `OVERLAP_STEP_PX`).
+    fn sampled_intersection(&self, other: &Ellipse) -> (u64, u64, u64) {
         let (Some(pa), Some(pb)) = (self.precision(), other.precision()) else {
-            return 0.0;
+            return (0, 0, 0);
         };
         let k2 = SHAPE_SIGMA * SHAPE_SIGMA;
         let (ba, bb) = (self.bbox(SHAPE_SIGMA), other.bbox(SHAPE_SIGMA));
@@ -149,9 +172,9 @@ impl Ellipse {
         let y1 = (ba[3].max(bb[3]) / OVERLAP_STEP_PX).ceil() as i64;
         // guard against absurd sizes (a runaway covariance): at most 4096² samples
         if x1 - x0 > 4096 || y1 - y0 > 4096 {
-            return 0.0;
+            return (0, 0, 0);
         }
-        let (mut inter, mut union) = (0u64, 0u64);
+        let (mut inter, mut own, mut union) = (0u64, 0u64, 0u64);
         for j in y0..=y1 {
             let y = j as f64 * OVERLAP_STEP_PX;
             for i in x0..=x1 {
@@ -161,14 +184,11 @@ impl Ellipse {
                 let ina = da.dot(&(pa * da)) <= k2;
                 let inb = db.dot(&(pb * db)) <= k2;
                 inter += u64::from(ina && inb);
+                own += u64::from(ina);
                 union += u64::from(ina || inb);
             }
         }
-        if union == 0 {
-            0.0
-        } else {
-            inter as f64 / union as f64
-        }
+        (inter, own, union)
     }
 }
 
@@ -223,5 +243,10 @@ mod tests {
         );
         let far = Ellipse::from_parts(500.0, 0.0, 100.0, 0.0, 100.0);
         assert_eq!(small.overlap(&far), 0.0);
+        // covered_by: all of the small one lies in the big one, a quarter of the big one in
+        // the small one; disjoint: 0
+        assert!(close(small.covered_by(&big), 1.0, 1e-12));
+        assert!(close(big.covered_by(&small), 0.25, 0.01));
+        assert_eq!(small.covered_by(&far), 0.0);
     }
 }

@@ -111,8 +111,10 @@ fn one_on(obs: &[Observation], person: (i64, i64), what: &str) -> Observation {
     o
 }
 
+/// Regression: the blob used to start a new track instead of taking the colour track back,
+/// because the EM-like region (2.5σ boundary inside the body) is far smaller than the blob's
+/// moment ellipse: the IoU test and the one-sided gate both failed (see `vision::local`).
 #[test]
-#[ignore = "unfinished (E4): after the stand-still hand-over the walker is not re-acquired by a blob within 10 frames; see the branch report"]
 fn walking_standing_and_walking_again_keeps_one_track() {
     let mut t = LocalTracker::new(params()).expect("params");
     let mut k = 0;
@@ -175,8 +177,16 @@ fn walking_standing_and_walking_again_keeps_one_track() {
     assert!(s.reacquired >= 1);
 }
 
+/// Still failing, for a reason the association cannot fix: after the restart the GMM learns
+/// the walker as background (α = 1/(2n) is 1/18 when the 8 warm-up frames end, so a pixel
+/// covered for 2 frames is already background: (1 − α)² < 0.9), and only the leading 2–6
+/// columns of the 2 px/frame walker stay foreground, while the colour region settles on the
+/// trailing half of the uniform body. At the last frame the region is at x = 83.7 (σx 1.2) and
+/// the blob at x = 89.5 (σx 1.7): the two partial views are disjoint, beyond either gate.
+/// Fixing it needs selective background learning (no GMM update under tracked people while
+/// the model restarts), i.e. a per-pixel update mask in the `vision::gmm` kernels.
 #[test]
-#[ignore = "unfinished (E4): after the camera stops, the restarted background model absorbs the slow walker and no blob takes the colour track back; see the branch report"]
+#[ignore = "needs selective background learning after a GMM restart (see the doc comment): the restarted model absorbs the slow walker, leaving a leading-edge blob disjoint from the colour region"]
 fn camera_motion_hands_over_to_the_colour_tracker_and_back() {
     let mut t = LocalTracker::new(params()).expect("params");
     let mut k = 0;
