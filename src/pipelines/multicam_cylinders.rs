@@ -48,6 +48,17 @@ pub enum Detector {
     Log,
 }
 
+/// How the Gabor background learns (`vision::gabor::Update`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BackgroundUpdate {
+    /// Eq. 2 as printed: every pixel with weight α.
+    All,
+    /// Our addition: foreground pixels (dilated by the Gabor filter radius) learn at
+    /// `foreground_alpha` instead of α, so walkers leave no trail.
+    Selective,
+}
+
 /// `[params]` of `pipelines/multicam_cylinders.toml`; the file says where each default comes
 /// from.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -70,6 +81,9 @@ pub struct Params {
     /// Frames, spread evenly over the log, whose per-pixel median starts the background
     /// (0: the first frame, as eq. 2 alone would).
     pub bootstrap_frames: usize,
+    pub background_update: BackgroundUpdate,
+    /// Learning rate of foreground pixels under `background_update = "selective"`.
+    pub foreground_alpha: f64,
     // §3 detection
     pub person_height_m: f64,
     pub template_scales: usize,
@@ -130,6 +144,8 @@ impl Default for Params {
             gabor_wavelength_px: 8.0,
             mad_k: 3.0,
             bootstrap_frames: 25,
+            background_update: BackgroundUpdate::Selective,
+            foreground_alpha: 0.0,
             person_height_m: 1.75,
             template_scales: 4,
             template_tilts: 4,
@@ -225,6 +241,12 @@ impl Experiment for MulticamCylinders {
             bad(
                 "gabor_wavelength_px",
                 format!("{} is below 2 px", p.gabor_wavelength_px),
+            );
+        }
+        if !(p.foreground_alpha >= 0.0 && p.foreground_alpha < 1.0) {
+            bad(
+                "foreground_alpha",
+                format!("{} is not in [0, 1)", p.foreground_alpha),
             );
         }
         if !(p.mad_k >= 0.0 && p.mad_k.is_finite()) {
@@ -348,5 +370,36 @@ impl Experiment for MulticamCylinders {
 
     fn aggregate(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
         evaluate::aggregate(ctx, p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::config;
+
+    #[test]
+    fn the_shipped_pipeline_file_states_the_code_defaults_and_bad_values_are_named() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("pipelines/multicam_cylinders.toml");
+        let text = std::fs::read_to_string(&path).expect("pipeline file");
+        let mut file = config::parse::<Params>(&path, &text).expect("parses");
+        assert!(MulticamCylinders::validate(&file.params).is_empty());
+        // every default is written out in the file, with where it comes from; the furniture
+        // of the figure is the dataset's, not a default
+        assert_eq!(file.params.figure_obstacles_m.len(), 5);
+        file.params.figure_obstacles_m.clear();
+        let json = |p: &Params| serde_json::to_value(p).expect("json");
+        assert_eq!(json(&file.params), json(&Params::default()));
+        let mut p = Params::default();
+        p.alpha = 0.0;
+        p.foreground_alpha = 1.0;
+        p.mad_k = f64::NAN;
+        p.cameras.truncate(1);
+        let named: Vec<String> = MulticamCylinders::validate(&p)
+            .into_iter()
+            .map(|(k, _)| k)
+            .collect();
+        assert_eq!(named, ["cameras", "alpha", "foreground_alpha", "mad_k"]);
     }
 }

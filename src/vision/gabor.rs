@@ -27,9 +27,18 @@
 //! `median + k · 1.4826 · MAD` (Median Absolute Deviation, Rosin 1999 [4]; 1.4826 makes the
 //! MAD a consistent estimate of a Gaussian σ).
 //!
-//! What it does not do: no shadow model, no morphology, no selective (foreground-masked)
-//! update — the paper updates every pixel. σ, λ and k are not given in the paper; they are
-//! parameters.
+//! Besides eq. 2, which updates every pixel, [`Update::Selective`] (our addition, not in the
+//! paper) learns foreground pixels at a lower rate: a person walking over a pixel for ~9
+//! frames otherwise blends `1 − (1 − α)⁹` of their contrast into `B` (17 % at α = 0.02), and
+//! that residue stays above a noise-level MAD threshold for seconds — a trail behind every
+//! walker. The selective rule segments against `Bᵗ⁻¹`, dilates the mask by the filter radius
+//! (the features of pixels next to a person see the person through the kernel), and then
+//! updates with α outside and `α_fg` inside it. With the all-pixel rule the order does not
+//! matter for the mask: `‖Bᵗ − Mᵗ‖ = (1 − α) ‖Bᵗ⁻¹ − Mᵗ‖`, and a median + k·MAD threshold is
+//! scale-invariant.
+//!
+//! What it does not do: no shadow model, no morphology on the segmentation. σ, λ and k are
+//! not given in the paper; they are parameters.
 
 use image::RgbImage;
 use rayon::prelude::*;
@@ -394,12 +403,29 @@ pub struct Segmentation {
     pub foreground: usize,
 }
 
+/// How the background model learns from a frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Update {
+    /// Eq. 2 as printed: every pixel with weight α.
+    All,
+    /// Our addition: α outside the foreground (dilated by `dilate_px`), `foreground_alpha`
+    /// inside it (0 freezes it; a small rate lets wrongly segmented regions heal).
+    Selective {
+        foreground_alpha: f64,
+        dilate_px: u32,
+    },
+}
+
 /// The running-average Gabor background of one camera.
 #[derive(Debug, Clone)]
 pub struct GaborBackground {
     bank: GaborBank,
     /// Learning rate α of eq. 2.
     alpha: f32,
+    update: Update,
+    /// The update mask of [`Update::Selective`] (dilated foreground) and its row-pass scratch.
+    grown: Vec<u8>,
+    grown_rows: Vec<u8>,
     /// k of the MAD threshold.
     mad_k: f64,
     model: Option<Features>,
@@ -425,12 +451,31 @@ impl GaborBackground {
         Ok(GaborBackground {
             bank,
             alpha: alpha as f32,
+            update: Update::All,
+            grown: Vec::new(),
+            grown_rows: Vec::new(),
             mad_k,
             model: None,
             current: Features::default(),
             distance: Vec::new(),
             scratch: Scratch::default(),
         })
+    }
+
+    /// Use `update` instead of eq. 2's all-pixel rule.
+    pub fn with_update(mut self, update: Update) -> Result<GaborBackground, GaborError> {
+        if let Update::Selective {
+            foreground_alpha, ..
+        } = update
+            && !(foreground_alpha.is_finite() && (0.0..1.0).contains(&foreground_alpha))
+        {
+            return Err(GaborError::BadParameter {
+                name: "foreground_alpha",
+                reason: format!("{foreground_alpha} is not in [0, 1)"),
+            });
+        }
+        self.update = update;
+        Ok(self)
     }
 
     /// The distance image of the last frame (`‖Bᵗ − Mᵗ‖`, row-major).
@@ -516,12 +561,15 @@ impl GaborBackground {
             self.distance.resize(n, 0.0);
             return Ok(Segmentation::default());
         };
-        // eq. 2: Bᵗ = (1 − α) Bᵗ⁻¹ + α Mᵗ, then the distance ‖Bᵗ − Mᵗ‖
+        // eq. 2: Bᵗ = (1 − α) Bᵗ⁻¹ + α Mᵗ, then the distance ‖Bᵗ − Mᵗ‖ (the selective rule
+        // measures against Bᵗ⁻¹ and updates after thresholding)
         let a = self.alpha;
-        for (b, m) in model.planes.iter_mut().zip(&self.current.planes) {
-            b.par_iter_mut()
-                .zip(m.par_iter())
-                .for_each(|(b, m)| *b = (1.0 - a) * *b + a * m);
+        if self.update == Update::All {
+            for (b, m) in model.planes.iter_mut().zip(&self.current.planes) {
+                b.par_iter_mut()
+                    .zip(m.par_iter())
+                    .for_each(|(b, m)| *b = (1.0 - a) * *b + a * m);
+            }
         }
         self.distance.resize(n, 0.0);
         let (bp, mp) = (&model.planes, &self.current.planes);
@@ -546,6 +594,30 @@ impl GaborBackground {
             .par_iter_mut()
             .zip(self.distance.par_iter())
             .for_each(|(m, d)| *m = u8::from(*d > t));
+        if let Update::Selective {
+            foreground_alpha,
+            dilate_px,
+        } = self.update
+        {
+            dilate(
+                &mask.data,
+                w as usize,
+                dilate_px as usize,
+                &mut self.grown_rows,
+                &mut self.grown,
+            );
+            let rates = [a, foreground_alpha as f32];
+            let grown = &self.grown;
+            for (b, m) in model.planes.iter_mut().zip(&self.current.planes) {
+                b.par_iter_mut()
+                    .zip(m.par_iter())
+                    .zip(grown.par_iter())
+                    .for_each(|((b, m), &g)| {
+                        let a = rates[usize::from(g)];
+                        *b = (1.0 - a) * *b + a * m;
+                    });
+            }
+        }
         Ok(Segmentation {
             threshold,
             median,
@@ -553,6 +625,47 @@ impl GaborBackground {
             foreground: mask.count(),
         })
     }
+}
+
+/// Binary dilation of a 0/1 image (row-major, `w` wide) by a `(2r + 1)²` square: a row pass
+/// over prefix counts, then an OR of `2r + 1` rows.
+fn dilate(src: &[u8], w: usize, r: usize, rows: &mut Vec<u8>, out: &mut Vec<u8>) {
+    let n = src.len();
+    out.clear();
+    out.resize(n, 0);
+    if w == 0 || n == 0 {
+        return;
+    }
+    if r == 0 {
+        out.copy_from_slice(src);
+        return;
+    }
+    let h = n / w;
+    rows.clear();
+    rows.resize(n, 0);
+    rows.par_chunks_mut(w)
+        .zip(src.par_chunks(w))
+        .for_each(|(dst, line)| {
+            // any set pixel within ±r along the row
+            let mut prefix = vec![0u32; w + 1];
+            for (i, &v) in line.iter().enumerate() {
+                prefix[i + 1] = prefix[i] + u32::from(v);
+            }
+            for (i, d) in dst.iter_mut().enumerate() {
+                let (lo, hi) = (i.saturating_sub(r), (i + r + 1).min(w));
+                *d = u8::from(prefix[hi] > prefix[lo]);
+            }
+        });
+    let rows: &[u8] = rows;
+    // column pass: OR of the row-dilated lines y − r ..= y + r (O(r) per pixel; r is the
+    // filter radius, a few pixels)
+    out.par_chunks_mut(w).enumerate().for_each(|(y, dst)| {
+        for yy in y.saturating_sub(r)..(y + r + 1).min(h) {
+            for (d, &v) in dst.iter_mut().zip(&rows[yy * w..(yy + 1) * w]) {
+                *d |= v;
+            }
+        }
+    });
 }
 
 #[cfg(test)]
@@ -765,5 +878,131 @@ mod tests {
             booted.bootstrap(&[bg.clone(), RgbImage::new(10, 10)]),
             Err(GaborError::SizeMismatch { .. })
         ));
+    }
+
+    #[test]
+    fn dilation_equals_the_brute_force_square() {
+        let (w, h) = (23usize, 17usize);
+        let src: Vec<u8> = (0..w * h)
+            .map(|i| u8::from((i * 7919) % 61 == 0 || i == 0 || i == w * h - 1))
+            .collect();
+        for r in [0usize, 1, 2, 6, 30] {
+            let (mut rows, mut out) = (Vec::new(), Vec::new());
+            dilate(&src, w, r, &mut rows, &mut out);
+            for y in 0..h {
+                for x in 0..w {
+                    let want = (y.saturating_sub(r)..(y + r + 1).min(h)).any(|yy| {
+                        (x.saturating_sub(r)..(x + r + 1).min(w)).any(|xx| src[yy * w + xx] == 1)
+                    });
+                    assert_eq!(out[y * w + x], u8::from(want), "r {r} at ({x}, {y})");
+                }
+            }
+        }
+        // one pixel in the middle grows into exactly a (2r + 1)² square
+        let mut one = vec![0u8; w * h];
+        one[8 * w + 11] = 1;
+        let (mut rows, mut out) = (Vec::new(), Vec::new());
+        dilate(&one, w, 3, &mut rows, &mut out);
+        assert_eq!(out.iter().map(|&v| usize::from(v)).sum::<usize>(), 49);
+    }
+
+    #[test]
+    fn selective_update_leaves_no_trail_where_eq2_does() {
+        let (w, h) = (48u32, 32u32);
+        let bg = RgbImage::from_pixel(w, h, image::Rgb([120, 110, 100]));
+        let mut fg = bg.clone();
+        for y in 8..24 {
+            for x in 16..32 {
+                fg.put_pixel(x, y, image::Rgb([30, 60, 200]));
+            }
+        }
+        let noisy = |img: &RgbImage, t: u32| {
+            let mut o = img.clone();
+            for (x, y, p) in o.enumerate_pixels_mut() {
+                // noise that changes from frame to frame (hash of x, y, t)
+                let d = ((x.wrapping_mul(73_856_093)
+                    ^ y.wrapping_mul(19_349_663)
+                    ^ t.wrapping_mul(83_492_791))
+                    % 5) as u8;
+                p.0 = p.0.map(|c| c.saturating_add(d));
+            }
+            o
+        };
+        let bank = GaborBank::new(GaborParams::default()).expect("bank");
+        let r = bank.radius() as u32;
+        let alpha = 0.05;
+        let all = GaborBackground::new(bank.clone(), alpha, 3.0).expect("all");
+        let selective = all
+            .clone()
+            .with_update(Update::Selective {
+                foreground_alpha: 0.0,
+                dilate_px: r,
+            })
+            .expect("selective");
+        let centre = 16 * w as usize + 24;
+        let mut results = Vec::new();
+        for mut model in [all, selective] {
+            let mut mask = Mask::default();
+            for t in 0..10 {
+                model.apply(&noisy(&bg, t), &mut mask).expect("bg");
+            }
+            let before: Vec<f32> = model
+                .model()
+                .expect("model")
+                .planes
+                .iter()
+                .map(|p| p[centre])
+                .collect();
+            // the square stays 10 frames, then leaves
+            for t in 10..20 {
+                model.apply(&noisy(&fg, t), &mut mask).expect("fg");
+                assert_eq!(mask.data[centre], 1);
+            }
+            let after: Vec<f32> = model
+                .model()
+                .expect("model")
+                .planes
+                .iter()
+                .map(|p| p[centre])
+                .collect();
+            let s = model.apply(&noisy(&bg, 20), &mut mask).expect("gone");
+            results.push((before, after, mask.data[centre], s.foreground));
+        }
+        let (before, after, trail, _) = &results[0];
+        // eq. 2: 1 − (1 − α)^10 = 40 % of the square's contrast is in the model
+        let mut mf = Features::default();
+        bank.features(&noisy(&fg, 10), &mut mf, &mut Scratch::default())
+            .expect("features");
+        let kept = 1.0 - (1.0f32 - alpha as f32).powi(10);
+        for f in 0..FILTERS {
+            let contrast = mf.planes[f][centre] - before[f];
+            if contrast.abs() > 1e-3 {
+                let got = (after[f] - before[f]) / contrast;
+                assert!((got - kept).abs() < 0.02, "filter {f}: {got} vs {kept}");
+            }
+        }
+        assert_eq!(*trail, 1, "eq. 2 leaves the square's trail");
+        // selective with α_fg = 0: the model under the square did not move at all
+        let (before, after, trail, fg_count) = &results[1];
+        assert_eq!(before, after);
+        assert_eq!(*trail, 0);
+        assert!(
+            *fg_count < results[0].3 / 4,
+            "{fg_count} vs {}",
+            results[0].3
+        );
+        // a bad α_fg is refused
+        let bank = GaborBank::new(GaborParams::default()).expect("bank");
+        let m = GaborBackground::new(bank, 0.02, 3.0).expect("model");
+        for bad in [-0.1, 1.0, f64::NAN] {
+            assert!(
+                m.clone()
+                    .with_update(Update::Selective {
+                        foreground_alpha: bad,
+                        dilate_px: 1
+                    })
+                    .is_err()
+            );
+        }
     }
 }

@@ -14,7 +14,7 @@ use nalgebra::{Point2, Point3};
 use polars::prelude::*;
 use rayon::prelude::*;
 
-use super::{Detector, Params, Topics};
+use super::{BackgroundUpdate, Detector, Params, Topics};
 use crate::geometry::camera::CameraModel;
 use crate::geometry::triangulate::{CalibratedView, triangulate_dlt};
 use crate::groundtruth::PeopleFrame;
@@ -24,7 +24,7 @@ use crate::run::{Frames, Session};
 use crate::time::Nanos;
 use crate::track::cylinders::{self, Cylinder, CylinderParams, CylinderTracker, Selection};
 use crate::track::graph_match::{Box2d, GraphParams, GraphTracker};
-use crate::vision::gabor::{GaborBackground, GaborBank, GaborParams, Mask};
+use crate::vision::gabor::{GaborBackground, GaborBank, GaborParams, Mask, Update};
 use crate::vision::template::{self, Detection, DetectorParams, Silhouette};
 
 /// Label of each source of 2-D objects in the tables.
@@ -568,7 +568,15 @@ pub(crate) fn process(
         } else {
             Vec::new()
         };
-        let mut background = GaborBackground::new(bank.clone(), p.alpha, p.mad_k)?;
+        let update = match p.background_update {
+            BackgroundUpdate::All => Update::All,
+            BackgroundUpdate::Selective => Update::Selective {
+                foreground_alpha: p.foreground_alpha,
+                dilate_px: bank.radius() as u32,
+            },
+        };
+        let mut background =
+            GaborBackground::new(bank.clone(), p.alpha, p.mad_k)?.with_update(update)?;
         if let Some(frames) = boot.get(c)
             && !frames.is_empty()
         {
