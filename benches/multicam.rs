@@ -20,7 +20,7 @@ use peopletrack::pipelines::multicam_cylinders::{MulticamCylinders, Params};
 use peopletrack::run::config::SessionRef;
 use peopletrack::run::{Experiment, Session};
 use peopletrack::synth::{SynthOptions, synthesize};
-use peopletrack::vision::gabor::{GaborBackground, GaborBank, GaborParams, Mask};
+use peopletrack::vision::gabor::{GaborBackground, GaborBank, GaborParams, Mask, Update};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -95,24 +95,36 @@ fn bench(c: &mut Criterion) {
         wavelength_px: p.gabor_wavelength_px,
     })
     .expect("bank");
-    let mut model = GaborBackground::new(bank, p.alpha, p.mad_k).expect("model");
-    let mut mask = Mask::default();
-    for f in &frames {
-        model.apply(f, &mut mask).expect("warm-up");
-    }
+    // eq. 2 as printed (every pixel learns) and the selective update of the default pipeline
+    let selective = Update::Selective {
+        foreground_alpha: p.foreground_alpha,
+        dilate_px: bank.radius() as u32,
+    };
     let mut g = c.benchmark_group("multicam_gabor_background");
     g.throughput(Throughput::Elements(1));
     g.sample_size(30);
-    let mut k = 0usize;
-    g.bench_function("352x288_frame", |b| {
-        b.iter(|| {
-            let s = model
-                .apply(&frames[k % frames.len()], &mut mask)
-                .expect("apply");
-            k += 1;
-            s.foreground
-        })
-    });
+    for (name, update) in [
+        ("352x288_frame_eq2_all", Update::All),
+        ("352x288_frame_selective", selective),
+    ] {
+        let mut model = GaborBackground::new(bank.clone(), p.alpha, p.mad_k)
+            .and_then(|m| m.with_update(update))
+            .expect("model");
+        let mut mask = Mask::default();
+        for f in &frames {
+            model.apply(f, &mut mask).expect("warm-up");
+        }
+        let mut k = 0usize;
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let s = model
+                    .apply(&frames[k % frames.len()], &mut mask)
+                    .expect("apply");
+                k += 1;
+                s.foreground
+            })
+        });
+    }
     g.finish();
 
     // the whole per-session processing (4 cameras)
