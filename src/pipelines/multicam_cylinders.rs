@@ -391,11 +391,13 @@ mod tests {
         file.params.figure_obstacles_m.clear();
         let json = |p: &Params| serde_json::to_value(p).expect("json");
         assert_eq!(json(&file.params), json(&Params::default()));
-        let mut p = Params::default();
-        p.alpha = 0.0;
-        p.foreground_alpha = 1.0;
-        p.mad_k = f64::NAN;
-        p.cameras.truncate(1);
+        let p = Params {
+            cameras: vec!["cam_0".into()],
+            alpha: 0.0,
+            foreground_alpha: 1.0,
+            mad_k: f64::NAN,
+            ..Params::default()
+        };
         let named: Vec<String> = MulticamCylinders::validate(&p)
             .into_iter()
             .map(|(k, _)| k)
