@@ -98,6 +98,9 @@ pub struct Params {
     pub template_stride_px: u32,
     pub nms_iou: f64,
     pub nms_contained: f64,
+    /// Head point of a box (log detections, ground-truth boxes): the box's top row on the
+    /// image of the person's vertical (`track::cylinders::box_head_px`); false: the top centre.
+    pub box_head_on_axis: bool,
     // §4 2-D tracking
     pub match_iou_2d: f64,
     pub max_missed_2d: u32,
@@ -155,6 +158,7 @@ impl Default for Params {
             template_stride_px: 2,
             nms_iou: 0.3,
             nms_contained: 0.7,
+            box_head_on_axis: true,
             match_iou_2d: 0.1,
             max_missed_2d: 2,
             p_th_px: 10.0,

@@ -646,7 +646,7 @@ fn clear_mot_table(s: &Scored, p: &Params) -> Table {
     .with_precision("match_m", 1)
     .with_note("Ground truth: every person inside the room at every frame (also those seen by fewer than two cameras, which no triangulation can place). A hypothesis matches a person within match_m on the ground (motmetrics 'euc' rule); MOTP is the mean matched distance in metres.")
     .with_note("Paper: no CLEAR MOT, IDF1 or error numbers are given (§6 reports figures 5–6 and qualitative statements only), hence '—'.")
-    .with_note(format!("Detectors: `{}` = the paper's chain (Gabor background, templates, graph-matching 2-D tracks); `{GT_BOXES}` = the ground-truth visible boxes of the log (top centre as head) through the same 2-D and 3-D stages; `log` = Detection2DArray topics.", super::session::TEMPLATES))
+    .with_note(format!("Detectors: `{}` = the paper's chain (Gabor background, templates, graph-matching 2-D tracks); `{GT_BOXES}` = the ground-truth visible boxes of the log through the same 2-D and 3-D stages (head: the box's top row on the image of the person's vertical, from the calibration; the top centre with box_head_on_axis = false); `log` = Detection2DArray topics.", super::session::TEMPLATES))
 }
 
 fn gt_boxes_table(s: &Scored, _p: &Params, summary: &mut Vec<String>) -> Option<Table> {
@@ -678,7 +678,7 @@ fn gt_boxes_table(s: &Scored, _p: &Params, summary: &mut Vec<String>) -> Option<
         )
         .with_precision("match_m", 1)
         .with_precision("target_MOTA", 2)
-        .with_note("Boxes are the visible extent of each person in each camera; the head is the box's top centre, as for any box detector. Misses here come from people seen by fewer than two cameras, from heads hidden by furniture or people, and from the N_app promotion delay.")
+        .with_note("Boxes are the visible extent of each person in each camera; the head is the point of the box's top row on the image of the person's vertical line, from the calibration (box_head_on_axis; in the corner cameras people lean and the top centre is off the head), as for any box detector. Misses here come from people seen by fewer than two cameras, from heads hidden by furniture or people, and from the N_app promotion delay.")
         .with_note("Paper: no number (the target 0.95 is this project's acceptance bar, not the paper's)."),
     )
 }
@@ -1092,7 +1092,7 @@ fn head_centroid_table(
         .with_precision("df", 0)
         .with_precision("p", 4)
         .with_precision("cohens_d", 2)
-        .with_note(format!("Per person and frame, each camera's detection is associated with the person by box overlap (IoU ≥ 0.25 with the visible ground-truth box); the head points (template top, or box top centre) and the blob centroids (foreground pixels in the template box, or box centre) of the associated cameras (≥ 2) are triangulated by DLT and the ground (x, y) compared with the truth. 'static occlusion': at least one camera sees the person with visibility < {} and no other person's box overlaps theirs there (so furniture hides them); 'unoccluded': visibility ≥ 0.95 in every camera used.", p.occluded_visibility))
+        .with_note(format!("Per person and frame, each camera's detection is associated with the person by box overlap (IoU ≥ 0.25 with the visible ground-truth box); the head points (template top, or the box head of the 3-D run) and the blob centroids (foreground pixels in the template box, or box centre) of the associated cameras (≥ 2) are triangulated by DLT and the ground (x, y) compared with the truth. 'static occlusion': at least one camera sees the person with visibility < {} and no other person's box overlaps theirs there (so furniture hides them); 'unoccluded': visibility ≥ 0.95 in every camera used.", p.occluded_visibility))
         .with_note("Consecutive frames of one person are correlated, so the t-test's n overstates the independent evidence; the effect size (Cohen's d) does not depend on n.")
         .with_note("Paper: argues (§5) that head points are more robust than centroids to static occlusion, without numbers.")
         .with_samples(samples),
@@ -1284,7 +1284,7 @@ fn detections_2d_table(s: &Scored, summary: &mut Vec<String>) -> anyhow::Result<
         let f1 = 2.0 * precision * recall / (precision + recall);
         if k == "all" {
             summary.push(format!(
-                "template detector alone (head within {DETECTION_HEAD_TOL} box widths of the visible ground-truth box's top centre): precision {precision:.3}, recall {recall:.3}, {:.1} detections for {:.1} people per camera and frame",
+                "template detector alone (head within {DETECTION_HEAD_TOL} box widths of the true head): precision {precision:.3}, recall {recall:.3}, {:.1} detections for {:.1} people per camera and frame",
                 v.2 as f64 / frames,
                 v.1 as f64 / frames
             ));
@@ -1316,7 +1316,7 @@ fn detections_2d_table(s: &Scored, summary: &mut Vec<String>) -> anyhow::Result<
         .with_precision("head_dx_abs_px", 1)
         .with_precision("head_dy_px", 1)
         .with_precision("height_ratio", 2)
-        .with_note(format!("A detection matches a ground-truth person (the visible box, at least 8 px tall) when its head point lies within {DETECTION_HEAD_TOL} × the box width of the box's top centre — the point the 3-D stage triangulates; IoU would punish the full-body template box of a person whose legs a desk hides — one to one, nearest first. Head offsets and height ratios are means over matched pairs: head_dy_px < 0 puts the detected head above the top of the visible box; height_ratio is the template's silhouette height over the visible box height (a desk hides the legs, so > 1 is expected there)."))
+        .with_note(format!("A detection matches a ground-truth person (the visible box, at least 8 px tall) when its head point lies within {DETECTION_HEAD_TOL} × the visible box width of the person's projected head top (from the log's ground truth; the box's top centre when the log has none) — the point the 3-D stage triangulates; IoU would punish the full-body template box of a person whose legs a desk hides — one to one, nearest first. Head offsets and height ratios are means over matched pairs: head_dy_px < 0 puts the detected head above the projected head top; height_ratio is the template's silhouette height over the visible box height (a desk hides the legs, so > 1 is expected there)."))
         .with_note("Paper: no detection numbers (fig. 3 shows the process on one frame)."),
     ))
 }

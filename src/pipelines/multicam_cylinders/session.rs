@@ -173,8 +173,39 @@ fn stamp_of(m: &Message, header: Option<Nanos>) -> Nanos {
     header.filter(|s| s.0 > 0).unwrap_or(m.log_time)
 }
 
+/// Where the head point of a box comes from.
+#[derive(Clone, Copy)]
+enum BoxHead<'a> {
+    /// The top centre of the box.
+    TopCentre,
+    /// [`cylinders::box_head_px`]: the top row on the image of the person's vertical.
+    Axis(&'a CalibratedView, f64),
+    /// The ground truth's projected head top where the log has it (evaluation only).
+    Truth,
+}
+
+impl BoxHead<'_> {
+    fn of(self, b: [f64; 4], truth: Option<[f64; 2]>) -> [f64; 2] {
+        let top_centre = [(b[0] + b[2]) / 2.0, b[1]];
+        match self {
+            BoxHead::TopCentre => top_centre,
+            BoxHead::Axis(view, z) => cylinders::box_head_px(view, b, z).unwrap_or(top_centre),
+            BoxHead::Truth => truth.unwrap_or(top_centre),
+        }
+    }
+}
+
+/// How the main run and the ground-truth-box run turn a box into a head point.
+fn box_head<'a>(p: &Params, view: &'a CalibratedView) -> BoxHead<'a> {
+    if p.box_head_on_axis {
+        BoxHead::Axis(view, 0.5 * p.person_height_m)
+    } else {
+        BoxHead::TopCentre
+    }
+}
+
 /// Boxes of one camera from a `Detection2DArray`.
-fn boxes_from_detections(d: &Detection2DArray) -> Vec<Box2d> {
+fn boxes_from_detections(d: &Detection2DArray, head: BoxHead) -> Vec<Box2d> {
     d.detections
         .iter()
         .filter(|x| {
@@ -186,9 +217,10 @@ fn boxes_from_detections(d: &Detection2DArray) -> Vec<Box2d> {
         })
         .map(|x| {
             let (x0, y0) = (x.center_x - x.size_x / 2.0, x.center_y - x.size_y / 2.0);
+            let bbox = [x0, y0, x0 + x.size_x, y0 + x.size_y];
             Box2d {
-                bbox: [x0, y0, x0 + x.size_x, y0 + x.size_y],
-                head_px: [x.center_x, y0],
+                bbox,
+                head_px: head.of(bbox, None),
                 width_px: x.size_x,
                 height_px: x.size_y,
             }
@@ -196,8 +228,8 @@ fn boxes_from_detections(d: &Detection2DArray) -> Vec<Box2d> {
         .collect()
 }
 
-/// Boxes of one camera from the ground truth: the visible box, its top centre as the head.
-fn boxes_from_truth(gt: &PeopleFrame, camera: &str) -> Vec<(u32, Box2d)> {
+/// Boxes of one camera from the ground truth: the visible box and its head point.
+fn boxes_from_truth(gt: &PeopleFrame, camera: &str, head: BoxHead) -> Vec<(u32, Box2d)> {
     let mut out = Vec::new();
     for person in &gt.people {
         for v in person.cameras.iter().filter(|v| v.camera == camera) {
@@ -209,7 +241,7 @@ fn boxes_from_truth(gt: &PeopleFrame, camera: &str) -> Vec<(u32, Box2d)> {
                 person.id,
                 Box2d {
                     bbox: b,
-                    head_px: [(b[0] + b[2]) / 2.0, b[1]],
+                    head_px: head.of(b, v.head_px),
                     width_px: b[2] - b[0],
                     height_px: b[3] - b[1],
                 },
@@ -308,7 +340,7 @@ fn iou(a: &[f64; 4], b: &[f64; 4]) -> f64 {
 }
 
 /// A template detection matches a ground-truth person when its head point is within this many
-/// visible-box widths of the top centre of the visible box.
+/// visible-box widths of the person's projected head top.
 pub(crate) const DETECTION_HEAD_TOL: f64 = 0.5;
 
 /// Template detections scored against the visible ground-truth boxes, one row per frame and
@@ -327,9 +359,9 @@ struct Det2dCols {
 
 impl Det2dCols {
     /// Greedy one-to-one matching by increasing head distance: a detection's head point must
-    /// lie within `head_tol` visible-box widths of the top centre of the visible box (the
-    /// point the 3-D stage triangulates; IoU would punish the full-body template box of a
-    /// person whose legs a desk hides).
+    /// lie within `head_tol` visible-box widths of the truth's head point (the point the 3-D
+    /// stage triangulates; IoU would punish the full-body template box of a person whose legs
+    /// a desk hides).
     fn push(
         &mut self,
         frame: usize,
@@ -678,7 +710,7 @@ pub(crate) fn process(
                     None => Vec::new(),
                     Some(Payload::Detections(d)) => {
                         out.present = true;
-                        boxes_from_detections(&d)
+                        boxes_from_detections(&d, box_head(p, &calib.views[c]))
                     }
                     Some(img) => {
                         out.present = true;
@@ -866,7 +898,7 @@ pub(crate) fn process(
             let mut cams = Vec::with_capacity(n_cams);
             for (c, tr) in trackers.iter_mut().enumerate() {
                 let boxes: Vec<Box2d> = gt
-                    .map(|g| boxes_from_truth(g, &p.cameras[c]))
+                    .map(|g| boxes_from_truth(g, &p.cameras[c], box_head(p, &calib.views[c])))
                     .unwrap_or_default()
                     .into_iter()
                     .map(|(_, b)| b)
@@ -1070,7 +1102,7 @@ pub(crate) fn process(
         for (k, gt) in gt_for_frame.iter().enumerate() {
             let Some(gt) = gt else { continue };
             for (c, cam) in p.cameras.iter().enumerate() {
-                let truth_boxes: Vec<Box2d> = boxes_from_truth(gt, cam)
+                let truth_boxes: Vec<Box2d> = boxes_from_truth(gt, cam, BoxHead::Truth)
                     .into_iter()
                     .map(|(_, b)| b)
                     .collect();
