@@ -672,6 +672,36 @@ fn dilate(src: &[u8], w: usize, r: usize, rows: &mut Vec<u8>, out: &mut Vec<u8>)
 mod tests {
     use super::*;
 
+    /// A flat background and the same with a blue square over `xs × ys`.
+    fn square_scene(
+        (w, h): (u32, u32),
+        xs: std::ops::Range<u32>,
+        ys: std::ops::Range<u32>,
+    ) -> (RgbImage, RgbImage) {
+        let bg = RgbImage::from_pixel(w, h, image::Rgb([120, 110, 100]));
+        let mut fg = bg.clone();
+        for y in ys {
+            for x in xs.clone() {
+                fg.put_pixel(x, y, image::Rgb([30, 60, 200]));
+            }
+        }
+        (bg, fg)
+    }
+
+    /// `img` with 0–4 grey levels of deterministic noise that changes from frame to frame (a
+    /// hash of x, y and the frame `t`), so that the MAD is not zero.
+    fn noisy(img: &RgbImage, t: u32) -> RgbImage {
+        let mut o = img.clone();
+        for (x, y, p) in o.enumerate_pixels_mut() {
+            let d = ((x.wrapping_mul(73_856_093)
+                ^ y.wrapping_mul(19_349_663)
+                ^ t.wrapping_mul(83_492_791))
+                % 5) as u8;
+            p.0 = p.0.map(|c| c.saturating_add(d));
+        }
+        o
+    }
+
     #[test]
     fn separable_kernels_match_the_closed_form() {
         for p in [
@@ -799,23 +829,7 @@ mod tests {
 
     #[test]
     fn a_new_object_is_segmented_and_the_background_absorbs_it_at_rate_alpha() {
-        let (w, h) = (40u32, 30u32);
-        let bg = RgbImage::from_pixel(w, h, image::Rgb([120, 110, 100]));
-        let mut fg = bg.clone();
-        for y in 10..22 {
-            for x in 15..25 {
-                fg.put_pixel(x, y, image::Rgb([30, 60, 200]));
-            }
-        }
-        // mild deterministic noise so that the MAD is not zero
-        let noisy = |img: &RgbImage, t: u32| {
-            let mut o = img.clone();
-            for (x, y, p) in o.enumerate_pixels_mut() {
-                let d = ((x * 7 + y * 13 + t * 5) % 5) as u8;
-                p.0 = p.0.map(|c| c.saturating_add(d));
-            }
-            o
-        };
+        let (bg, fg) = square_scene((40, 30), 15..25, 10..22);
         let bank = GaborBank::new(GaborParams::default()).expect("bank");
         let mut model = GaborBackground::new(bank, 0.05, 3.0).expect("model");
         let mut mask = Mask::default();
@@ -908,26 +922,8 @@ mod tests {
 
     #[test]
     fn selective_update_leaves_no_trail_where_eq2_does() {
-        let (w, h) = (48u32, 32u32);
-        let bg = RgbImage::from_pixel(w, h, image::Rgb([120, 110, 100]));
-        let mut fg = bg.clone();
-        for y in 8..24 {
-            for x in 16..32 {
-                fg.put_pixel(x, y, image::Rgb([30, 60, 200]));
-            }
-        }
-        let noisy = |img: &RgbImage, t: u32| {
-            let mut o = img.clone();
-            for (x, y, p) in o.enumerate_pixels_mut() {
-                // noise that changes from frame to frame (hash of x, y, t)
-                let d = ((x.wrapping_mul(73_856_093)
-                    ^ y.wrapping_mul(19_349_663)
-                    ^ t.wrapping_mul(83_492_791))
-                    % 5) as u8;
-                p.0 = p.0.map(|c| c.saturating_add(d));
-            }
-            o
-        };
+        let w = 48u32;
+        let (bg, fg) = square_scene((w, 32), 16..32, 8..24);
         let bank = GaborBank::new(GaborParams::default()).expect("bank");
         let r = bank.radius() as u32;
         let alpha = 0.05;
