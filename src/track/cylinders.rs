@@ -30,8 +30,9 @@
 //! **Additions not in the paper**, each a parameter: a plausibility check on triangulated
 //! heads (height range, inside the room plus a margin; the paper constrains its templates by
 //! the room size but says nothing here — without it, two-camera combinations of different
-//! people can triangulate to heads under the floor), and a gate on the distance between an
-//! existing object's prediction and its update (`gate_m`). If the exhaustive search would
+//! people can triangulate to heads under the floor; a coasting object predicted outside the
+//! room plus the margin is dropped at once rather than after `N_dis` frames), and a gate on
+//! the distance between an existing object's prediction and its update (`gate_m`). If the exhaustive search would
 //! exceed `max_combinations`, only combinations whose every camera pair is itself coherent
 //! within `2·p_Th` are tried — a pair's error is at most about `N_c/2` times the whole
 //! combination's, so this drops almost nothing; the step reports when it happened.
@@ -391,6 +392,12 @@ impl CylinderTracker {
         out
     }
 
+    /// Inside the room plus its margin (ground plane).
+    fn in_room(&self, x: f64, y: f64) -> bool {
+        let (r, m) = (self.params.room_m, self.params.room_margin_m);
+        x >= r[0] - m && x <= r[2] + m && y >= r[1] - m && y <= r[3] + m
+    }
+
     /// Triangulate and check one combination (indices into `prepared`, one per camera).
     fn evaluate(&self, prepared: &[Prepared], combo: &[usize]) -> Option<Hypothesis> {
         let p = &self.params;
@@ -402,14 +409,7 @@ impl CylinderTracker {
             .map(|&i| (prepared[i].origin, prepared[i].dir))
             .collect();
         let head = triangulate_rays(&rays).ok()?;
-        let room = p.room_m;
-        let m = p.room_margin_m;
-        if head.z < p.head_height_m.0
-            || head.z > p.head_height_m.1
-            || head.x < room[0] - m
-            || head.x > room[2] + m
-            || head.y < room[1] - m
-            || head.y > room[3] + m
+        if head.z < p.head_height_m.0 || head.z > p.head_height_m.1 || !self.in_room(head.x, head.y)
         {
             return None;
         }
@@ -600,10 +600,9 @@ impl CylinderTracker {
 
         // 1. update existing objects with combinations differing in at most one 2-D object
         let mut options: Vec<(f64, usize, Vec<usize>, Hypothesis)> = Vec::new();
-        for (k, obj) in self.objects.iter_mut().enumerate() {
+        for obj in self.objects.iter_mut() {
             obj.kf.predict(&f, &q);
             obj.age += 1;
-            let _ = k;
         }
         for (k, obj) in self.objects.iter().enumerate() {
             let base: BTreeMap<usize, usize> = obj
@@ -666,7 +665,9 @@ impl CylinderTracker {
                     obj.measured = None;
                 }
             }
-            if obj.misses >= self.params.n_dis {
+            // a coasting object whose prediction has left the room has left it (or its
+            // velocity is noise): not reported out there for the rest of N_dis
+            if obj.misses >= self.params.n_dis || !self.in_room(obj.kf.x[0], obj.kf.x[1]) {
                 discarded += 1;
             } else {
                 kept.push(obj);
@@ -1023,6 +1024,39 @@ mod tests {
         assert_eq!(t.step(&[]).0.len(), 1);
         assert_eq!(t.step(&[]).0.len(), 1);
         assert!(t.step(&[]).0.is_empty());
+    }
+
+    #[test]
+    fn a_coasting_object_is_dropped_when_its_prediction_leaves_the_room() {
+        // a (fast) person runs towards the x = 8 m wall and is then seen no more: the object
+        // coasts on its velocity, and is dropped as soon as it is predicted beyond the room's
+        // margin, long before N_dis; nothing is ever reported out there
+        let views = office_views(false);
+        let params = CylinderParams {
+            n_app: 2,
+            n_dis: 20,
+            ..Default::default()
+        };
+        let limit = params.room_m[2] + params.room_margin_m;
+        let mut t = CylinderTracker::new(views.clone(), params).expect("tracker");
+        for k in 0..8 {
+            let x = 4.2 + 0.4 * f64::from(k);
+            let (cyl, _) = t.step(&objects_for(&views, &[(1, x, 4.0, 1.8, 0.2)]));
+            assert!(k < 1 || cyl.len() == 1, "frame {k}: {cyl:?}");
+        }
+        let mut coasted = 0;
+        loop {
+            let (cyl, stats) = t.step(&[]);
+            assert!(cyl.iter().all(|c| c.x_m <= limit), "{cyl:?}");
+            if cyl.is_empty() {
+                assert_eq!(stats.discarded, 1);
+                break;
+            }
+            coasted += 1;
+            assert!(coasted < 10, "still coasting: {cyl:?}");
+        }
+        // last measurement at 7.0 m, about 0.4 m a frame: 7.4, 7.8, 8.2 stay inside 8.5
+        assert!((2..=4).contains(&coasted), "{coasted}");
     }
 
     #[test]
