@@ -121,6 +121,51 @@ pub struct LinePlot {
     pub y_range: Option<(f64, f64)>,
 }
 
+/// The legend corner of a top view that covers the fewest trajectory points, circles and
+/// sensors (a corner is the outer 40 % × 25 % of the plotted area; ties go to the first of
+/// upper right, lower right, upper left, lower left).
+fn emptiest_corner(p: &TopView, (x0, x1, y0, y1): (f64, f64, f64, f64)) -> SeriesLabelPosition {
+    let (w, h) = (x1 - x0, y1 - y0);
+    let pts: Vec<(f64, f64)> = p
+        .trajectories
+        .iter()
+        .flat_map(|t| t.points.iter().copied())
+        .chain(p.circles.iter().map(|c| (c.x, c.y)))
+        .chain(p.sensors.iter().map(|s| (s.x, s.y)))
+        .collect();
+    let corners = [
+        (SeriesLabelPosition::UpperRight, true, true),
+        (SeriesLabelPosition::LowerRight, true, false),
+        (SeriesLabelPosition::UpperLeft, false, true),
+        (SeriesLabelPosition::LowerLeft, false, false),
+    ];
+    let count = |right: bool, upper: bool| {
+        pts.iter()
+            .filter(|(x, y)| {
+                let in_x = if right {
+                    *x >= x1 - 0.4 * w
+                } else {
+                    *x <= x0 + 0.4 * w
+                };
+                let in_y = if upper {
+                    *y >= y1 - 0.25 * h
+                } else {
+                    *y <= y0 + 0.25 * h
+                };
+                in_x && in_y
+            })
+            .count()
+    };
+    let mut best = (usize::MAX, SeriesLabelPosition::UpperRight);
+    for (pos, right, upper) in corners {
+        let n = count(right, upper);
+        if n < best.0 {
+            best = (n, pos);
+        }
+    }
+    best.1
+}
+
 #[derive(Debug, Clone, Default)]
 pub struct ScatterPlot {
     pub x_label: String,
@@ -567,6 +612,7 @@ impl Figure {
         if p.trajectories.iter().any(|t| !t.name.is_empty()) {
             chart
                 .configure_series_labels()
+                .position(emptiest_corner(p, (x0, x1, y0, y1)))
                 .background_style(WHITE.mix(0.85))
                 .border_style(RGBColor(160, 160, 160))
                 .label_font(("sans-serif", 12))
@@ -794,6 +840,33 @@ pub fn least_squares(pts: &[(f64, f64)]) -> Option<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_top_view_legend_goes_to_the_emptiest_corner() {
+        let area = (0.0, 10.0, 0.0, 10.0);
+        let with = |pts: Vec<(f64, f64)>| TopView {
+            trajectories: vec![Series::line("a", pts, 0)],
+            ..TopView::default()
+        };
+        let pos = |v: &TopView| format!("{:?}", emptiest_corner(v, area));
+        // nothing anywhere: the first corner
+        assert_eq!(pos(&with(vec![])), "UpperRight");
+        // a track through the upper right: the next empty corner
+        assert_eq!(pos(&with(vec![(9.0, 9.0), (8.0, 9.5)])), "LowerRight");
+        // every corner but the lower left is crossed
+        let crossed = vec![
+            (9.0, 9.0),
+            (9.0, 1.0),
+            (1.0, 9.0),
+            (1.0, 1.0),
+            (2.0, 1.5),
+            (9.5, 0.5),
+            (8.5, 9.2),
+        ];
+        assert_eq!(pos(&with(crossed[..3].to_vec())), "LowerLeft");
+        // all crossed: the least crossed (upper left, one point; the others two)
+        assert_eq!(pos(&with(crossed)), "UpperLeft");
+    }
 
     /// Render, decode the PNG back, and count pixels that are not white.
     fn check(fig: &Figure) {
