@@ -936,31 +936,24 @@ mod tests {
             })
             .expect("selective");
         let centre = 16 * w as usize + 24;
+        // the 16 background features of the square's centre pixel
+        let at_centre = |m: &GaborBackground| -> Vec<f32> {
+            let planes = &m.model().expect("model").planes;
+            planes.iter().map(|p| p[centre]).collect()
+        };
         let mut results = Vec::new();
         for mut model in [all, selective] {
             let mut mask = Mask::default();
             for t in 0..10 {
                 model.apply(&noisy(&bg, t), &mut mask).expect("bg");
             }
-            let before: Vec<f32> = model
-                .model()
-                .expect("model")
-                .planes
-                .iter()
-                .map(|p| p[centre])
-                .collect();
+            let before = at_centre(&model);
             // the square stays 10 frames, then leaves
             for t in 10..20 {
                 model.apply(&noisy(&fg, t), &mut mask).expect("fg");
                 assert_eq!(mask.data[centre], 1);
             }
-            let after: Vec<f32> = model
-                .model()
-                .expect("model")
-                .planes
-                .iter()
-                .map(|p| p[centre])
-                .collect();
+            let after = at_centre(&model);
             let s = model.apply(&noisy(&bg, 20), &mut mask).expect("gone");
             results.push((before, after, mask.data[centre], s.foreground));
         }
