@@ -628,7 +628,7 @@ impl GaborBackground {
 }
 
 /// Binary dilation of a 0/1 image (row-major, `w` wide) by a `(2r + 1)²` square: a row pass
-/// over prefix counts, then an OR of `2r + 1` rows.
+/// (distance to the nearest set pixel, both ways), then an OR of `2r + 1` rows.
 fn dilate(src: &[u8], w: usize, r: usize, rows: &mut Vec<u8>, out: &mut Vec<u8>) {
     let n = src.len();
     out.clear();
@@ -646,14 +646,17 @@ fn dilate(src: &[u8], w: usize, r: usize, rows: &mut Vec<u8>, out: &mut Vec<u8>)
     rows.par_chunks_mut(w)
         .zip(src.par_chunks(w))
         .for_each(|(dst, line)| {
-            // any set pixel within ±r along the row
-            let mut prefix = vec![0u32; w + 1];
-            for (i, &v) in line.iter().enumerate() {
-                prefix[i + 1] = prefix[i] + u32::from(v);
+            // any set pixel within ±r along the row: the distance to the last set pixel,
+            // sweeping left to right and then right to left (no allocation per row)
+            let mut since = usize::MAX;
+            for (d, &v) in dst.iter_mut().zip(line) {
+                since = if v != 0 { 0 } else { since.saturating_add(1) };
+                *d = u8::from(since <= r);
             }
-            for (i, d) in dst.iter_mut().enumerate() {
-                let (lo, hi) = (i.saturating_sub(r), (i + r + 1).min(w));
-                *d = u8::from(prefix[hi] > prefix[lo]);
+            since = usize::MAX;
+            for (d, &v) in dst.iter_mut().zip(line).rev() {
+                since = if v != 0 { 0 } else { since.saturating_add(1) };
+                *d |= u8::from(since <= r);
             }
         });
     let rows: &[u8] = rows;
