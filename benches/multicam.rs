@@ -48,7 +48,7 @@ fn session() -> PathBuf {
             profile: "quick".into(),
             out: Some(dir.clone()),
             preview_root: None,
-            progress: false,
+            progress: None,
         },
     )
     .expect("synthesizes");
@@ -153,7 +153,7 @@ fn bench(c: &mut Criterion) {
                 log: SessionLog::open(&path).expect("open"),
                 info: info.clone(),
             };
-            MulticamCylinders::process(&s, &p, &BTreeMap::new(), &indicatif::ProgressBar::hidden())
+            MulticamCylinders::process(&s, &p, &BTreeMap::new(), &peopletrack::progress::Silent)
                 .expect("process")
                 .len()
         })

@@ -12,6 +12,7 @@ pub mod groundtruth;
 pub mod learn;
 pub mod log;
 pub mod pipelines;
+pub mod progress;
 pub mod report;
 pub mod run;
 pub mod synth;

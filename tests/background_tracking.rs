@@ -100,7 +100,7 @@ fn synth(dir: &Path) -> PathBuf {
             profile: "quick".into(),
             out: Some(out.clone()),
             preview_root: None,
-            progress: false,
+            progress: None,
         },
     )
     .expect("synthesizes");

@@ -137,7 +137,7 @@ fn fixture() -> &'static Fixture {
                 profile: "quick".into(),
                 out: Some(base.join("synth/multicam_office")),
                 preview_root: None,
-                progress: false,
+                progress: None,
             },
         )
         .expect("synthesizes");

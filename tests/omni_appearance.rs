@@ -18,7 +18,7 @@ fn opts(out: &Path) -> RunOptions {
         force: false,
         out: out.to_path_buf(),
         git_commit: "test".into(),
-        progress: false,
+        progress: None,
         write_tracks: None,
     }
 }
@@ -69,7 +69,7 @@ fn calibrates_learns_tracks_and_the_saved_model_reproduces_its_estimates() {
             profile: "quick".into(),
             out: Some(logs.clone()),
             preview_root: Some(dir.path().join("preview")),
-            progress: false,
+            progress: None,
         },
     )
     .expect("synthesizes");

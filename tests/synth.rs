@@ -25,7 +25,7 @@ fn synth_into(dir: &Path, threads: usize) -> Vec<PathBuf> {
                 profile: "quick".into(),
                 out: Some(dir.to_path_buf()),
                 preview_root: Some(dir.join("preview")),
-                progress: false,
+                progress: None,
             },
         )
         .expect("synthesizes")

@@ -4,6 +4,7 @@
 pub mod cat;
 pub mod eval;
 pub mod inspect;
+pub mod progress;
 pub mod run;
 pub mod score;
 pub mod synth;

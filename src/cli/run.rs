@@ -56,7 +56,7 @@ pub fn options(a: &Args, progress: bool) -> RunOptions {
         force: a.force,
         out: a.out.clone(),
         git_commit: super::git_commit(),
-        progress,
+        progress: super::progress::shared(progress),
         write_tracks: a.write_tracks.as_ref().map(|d| {
             if d.as_os_str().is_empty() {
                 a.out.join("tracks")

@@ -50,7 +50,7 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
                 profile: a.profile.clone(),
                 out: a.out.clone(),
                 preview_root: Some(a.preview.clone()),
-                progress: super::stderr_is_terminal(),
+                progress: super::progress::shared(super::stderr_is_terminal()),
             },
         )?;
         writeln!(

@@ -60,7 +60,7 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         force: a.force,
         out: a.out.clone(),
         git_commit: super::git_commit(),
-        progress: super::stderr_is_terminal(),
+        progress: super::progress::shared(super::stderr_is_terminal()),
         write_tracks: None,
     };
     atomic::sweep_scratch(&a.out)?;

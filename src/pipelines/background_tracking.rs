@@ -31,9 +31,9 @@ use std::collections::{BTreeMap, VecDeque};
 use std::path::Path;
 use std::time::Instant;
 
+use crate::progress::Progress;
 use anyhow::Context;
 use image::RgbImage;
-use indicatif::ProgressBar;
 use polars::prelude::*;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -52,7 +52,7 @@ use crate::report::figure::{
 };
 use crate::report::{Figure, Table};
 use crate::run::config::Invalid;
-use crate::run::{Aggregate, Experiment, Frames, Products, Session, Stage};
+use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
 use crate::vision::blobs::{self, Connectivity};
 use crate::vision::colortrack::{
     BinImage, ColorSpace, ColorTracker, EmParams, MeanShiftParams, Method,
@@ -716,8 +716,8 @@ impl Experiment for BackgroundTracking {
         s: &Session,
         p: &Params,
         topics: &BTreeMap<String, String>,
-        bar: &ProgressBar,
-    ) -> anyhow::Result<Frames> {
+        bar: &dyn Progress,
+    ) -> anyhow::Result<SessionTables> {
         let tp = topics_of(p, topics);
         let log = &s.log;
         let has_mask = log.summary().channel(&tp.mask).is_some();
@@ -1027,7 +1027,7 @@ impl Experiment for BackgroundTracking {
             );
         }
 
-        let mut out = Frames::new();
+        let mut out = SessionTables::new();
         let st = local.stats();
         out.insert(
             "session".into(),
@@ -1168,7 +1168,7 @@ fn model_name(adaptive: bool) -> &'static str {
 // ---------------------------------------------------------------------------------------------
 // Aggregation
 
-fn session_value_i64(frames: &Frames, name: &str) -> i64 {
+fn session_value_i64(frames: &SessionTables, name: &str) -> i64 {
     frames
         .get("session")
         .and_then(|d| col_i64(d, name).ok())
@@ -1189,8 +1189,8 @@ fn sanitize(s: &str) -> String {
 }
 
 /// Datasets in first-seen order with their sessions.
-fn by_dataset<'a>(ctx: &'a Aggregate) -> Vec<(String, Vec<&'a Frames>)> {
-    let mut out: Vec<(String, Vec<&Frames>)> = Vec::new();
+fn by_dataset<'a>(ctx: &'a Aggregate) -> Vec<(String, Vec<&'a SessionTables>)> {
+    let mut out: Vec<(String, Vec<&SessionTables>)> = Vec::new();
     for (info, frames) in ctx.sessions {
         match out.iter_mut().find(|(d, _)| *d == info.dataset) {
             Some((_, v)) => v.push(frames),
@@ -1901,7 +1901,7 @@ fn colour_products(ctx: &Aggregate, p: &Params, products: &mut Products) -> anyh
 
 fn colour_figures(
     info: &crate::run::config::SessionRef,
-    frames: &Frames,
+    frames: &SessionTables,
     groups: &[((String, String), MethodRows)],
     p: &Params,
     products: &mut Products,

@@ -5,8 +5,8 @@
 
 use std::collections::BTreeMap;
 
+use crate::progress::Progress;
 use anyhow::Context;
-use indicatif::ProgressBar;
 use polars::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -18,7 +18,7 @@ use crate::report::{Figure, Table};
 
 use super::columns::{concat as stack, f64s as col_f64, strs as col_str};
 use crate::run::config::Invalid;
-use crate::run::{Aggregate, Experiment, Frames, Products, Session, Stage};
+use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
 
 pub struct DatasetQuality;
 
@@ -88,8 +88,8 @@ impl Experiment for DatasetQuality {
         s: &Session,
         p: &Params,
         topics: &BTreeMap<String, String>,
-        bar: &ProgressBar,
-    ) -> anyhow::Result<Frames> {
+        bar: &dyn Progress,
+    ) -> anyhow::Result<SessionTables> {
         bar.set_length(3);
         bar.set_message("topics");
         let log = &s.log;
@@ -194,7 +194,7 @@ impl Experiment for DatasetQuality {
             "gt_max_speed_mps" => [speeds.iter().copied().reduce(f64::max)],
             "gt_mean_visibility" => [mean(&visibilities)],
         }?;
-        Ok(Frames::from([
+        Ok(SessionTables::from([
             ("session".to_string(), session_df),
             ("topics".to_string(), topics_df),
             ("rates".to_string(), rates_df),

@@ -63,7 +63,7 @@ mod tests {
                 force: false,
                 out: dir.path().join("out"),
                 git_commit: String::new(),
-                progress: false,
+                progress: None,
                 write_tracks: None,
             };
             if let Err(e) = run_file(&path, &opts) {

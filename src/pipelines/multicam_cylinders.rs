@@ -27,12 +27,12 @@ mod session;
 
 use std::collections::BTreeMap;
 
-use indicatif::ProgressBar;
+use crate::progress::Progress;
 use serde::{Deserialize, Serialize};
 
 use crate::groundtruth::PEOPLE_TOPIC;
 use crate::run::config::Invalid;
-use crate::run::{Aggregate, Experiment, Frames, Products, Session, Stage};
+use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
 use crate::track::cylinders::Selection;
 
 pub struct MulticamCylinders;
@@ -367,8 +367,8 @@ impl Experiment for MulticamCylinders {
         s: &Session,
         p: &Params,
         remap: &BTreeMap<String, String>,
-        bar: &ProgressBar,
-    ) -> anyhow::Result<Frames> {
+        bar: &dyn Progress,
+    ) -> anyhow::Result<SessionTables> {
         session::process(s, p, &topics(p, remap), bar)
     }
 

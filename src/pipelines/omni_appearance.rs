@@ -20,9 +20,9 @@
 
 use std::collections::BTreeMap;
 
+use crate::progress::Progress;
 use anyhow::Context;
 use image::RgbImage;
-use indicatif::ProgressBar;
 use nalgebra::{Matrix2, Vector2};
 use polars::prelude::*;
 use rand::seq::SliceRandom;
@@ -42,7 +42,7 @@ use crate::report::figure::{
 };
 use crate::report::{Figure, Table};
 use crate::run::config::Invalid;
-use crate::run::{Aggregate, Experiment, Frames, Products, Session, Stage};
+use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
 use crate::synth::rng;
 use crate::track::position::{PositionKf, covariance};
 use crate::vision::omni::{Background, Unwrapper, features};
@@ -241,8 +241,8 @@ impl Experiment for OmniAppearance {
         s: &Session,
         p: &Params,
         _: &BTreeMap<String, String>,
-        bar: &ProgressBar,
-    ) -> anyhow::Result<Frames> {
+        bar: &dyn Progress,
+    ) -> anyhow::Result<SessionTables> {
         let log = &s.log;
         let tf = TfBuffer::from_log(log, 1e6)?;
         let t0 = log
@@ -264,7 +264,7 @@ impl Experiment for OmniAppearance {
             ),
         );
         for (k, name) in p.webcams.iter().enumerate() {
-            bar.set_message(format!("hats in {name}"));
+            bar.set_message(&format!("hats in {name}"));
             let info = first_info(log, name)?;
             let pose = tf
                 .lookup("map", name, t0)
@@ -419,7 +419,7 @@ impl Experiment for OmniAppearance {
         let pose = df! {
             "x" => [omni_pose.translation.x], "y" => [omni_pose.translation.y], "yaw" => [ox.y.atan2(ox.x)],
         }?;
-        Ok(Frames::from([
+        Ok(SessionTables::from([
             ("cameras".to_string(), cameras),
             ("camera_truth".to_string(), camera_truth),
             ("hats".to_string(), hats),

@@ -22,7 +22,6 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use anyhow::Context;
-use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use polars::prelude::DataFrame;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -30,12 +29,13 @@ use serde::de::DeserializeOwned;
 use xxhash_rust::xxh3::Xxh3;
 
 use crate::log::SessionLog;
+use crate::progress::{Progress, SharedReporter, reporter};
 use crate::report::table::{parquet_bytes, read_parquet};
 use crate::report::{Figure, Provenance, Table, atomic, table::write_table, write_figure};
 use config::{ConfigError, Invalid, PipelineFile, SessionRef};
 
-/// Tables produced for one session, by name.
-pub type Frames = BTreeMap<String, DataFrame>;
+/// Tables produced for one session, by name (cached as Parquet).
+pub type SessionTables = BTreeMap<String, DataFrame>;
 
 /// One session as an experiment sees it.
 pub struct Session {
@@ -67,7 +67,7 @@ pub struct Products {
 
 /// Context handed to `aggregate`.
 pub struct Aggregate<'a> {
-    pub sessions: &'a [(SessionRef, Frames)],
+    pub sessions: &'a [(SessionRef, SessionTables)],
     pub provenance: Provenance,
     /// `--write-tracks`: folder for copies of the logs with the tracks added (pipelines that
     /// produce tracks; others ignore it).
@@ -96,15 +96,15 @@ pub trait Experiment: Sync {
         session: &Session,
         params: &Self::Params,
         topics: &BTreeMap<String, String>,
-        progress: &ProgressBar,
-    ) -> anyhow::Result<Frames>;
+        progress: &dyn Progress,
+    ) -> anyhow::Result<SessionTables>;
 
     /// Turn all sessions' tables into result tables and figures.
     fn aggregate(ctx: &Aggregate, params: &Self::Params) -> anyhow::Result<Products>;
 }
 
 /// Options from the command line.
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 pub struct RunOptions {
     /// Replace the pipeline's input globs.
     pub sessions: Option<Vec<String>>,
@@ -118,8 +118,8 @@ pub struct RunOptions {
     pub out: PathBuf,
     /// Git commit and tool version for provenance.
     pub git_commit: String,
-    /// Show progress bars (off in tests).
-    pub progress: bool,
+    /// Progress bars (`None` in tests: silent).
+    pub progress: SharedReporter,
     /// Write tracks back into copies of the logs under this folder (`--write-tracks`).
     pub write_tracks: Option<PathBuf>,
 }
@@ -171,12 +171,12 @@ fn session_dir(out: &Path, pipeline: &str, s: &SessionRef) -> PathBuf {
 const KEY_FILE: &str = "key.txt";
 
 /// Load cached frames if the key matches.
-fn load_cached(dir: &Path, key: &str) -> Option<Frames> {
+fn load_cached(dir: &Path, key: &str) -> Option<SessionTables> {
     let stored = std::fs::read_to_string(dir.join(KEY_FILE)).ok()?;
     if stored.trim() != key {
         return None;
     }
-    let mut frames = Frames::new();
+    let mut frames = SessionTables::new();
     for entry in std::fs::read_dir(dir).ok()? {
         let p = entry.ok()?.path();
         if p.extension().is_some_and(|e| e == "parquet") {
@@ -192,7 +192,7 @@ fn store(
     out: &Path,
     dir: &Path,
     key: &str,
-    frames: &Frames,
+    frames: &SessionTables,
     prov: &Provenance,
 ) -> anyhow::Result<()> {
     let tag = xxhash_rust::xxh3::xxh3_64(dir.to_string_lossy().as_bytes());
@@ -353,23 +353,15 @@ pub fn run_experiment<E: Experiment>(
             .collect(),
     };
 
-    let multi = MultiProgress::new();
-    if !opts.progress {
-        multi.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-    }
-    let total = multi.add(ProgressBar::new(sessions.len() as u64));
-    total.set_style(
-        ProgressStyle::with_template("{prefix:>20} [{bar:30}] {pos}/{len} sessions {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    total.set_prefix(name.clone());
+    let bars = reporter(&opts.progress);
+    let total = bars.bar(&name, "sessions");
+    total.set_length(sessions.len() as u64);
     let counts = Mutex::new((0usize, 0usize));
-    let results: Vec<Result<(SessionRef, Frames), (SessionRef, String)>> = sessions
+    let results: Vec<Result<(SessionRef, SessionTables), (SessionRef, String)>> = sessions
         .par_iter()
         .map(|s| {
             let dir = session_dir(&opts.out, &name, s);
-            let outcome = (|| -> anyhow::Result<(Frames, bool)> {
+            let outcome = (|| -> anyhow::Result<(SessionTables, bool)> {
                 let file_hash =
                     hash_file(&s.path).with_context(|| format!("reading {}", s.path.display()))?;
                 let mut h = Xxh3::new();
@@ -393,20 +385,13 @@ pub fn run_experiment<E: Experiment>(
                 if !missing.is_empty() {
                     anyhow::bail!("missing topic(s) {}", missing.join(", "));
                 }
-                let bar = multi.add(ProgressBar::new(0));
-                bar.set_style(
-                    ProgressStyle::with_template("{prefix:>20} [{bar:30}] {pos}/{len} {msg}")
-                        .unwrap_or_else(|_| ProgressStyle::default_bar())
-                        .progress_chars("=> "),
-                );
-                bar.set_prefix(format!("{}/{}", s.dataset, s.name));
+                let bar = bars.bar(&format!("{}/{}", s.dataset, s.name), "");
                 let session = Session {
                     log,
                     info: s.clone(),
                 };
-                let frames = E::process(&session, &file.params, &file.topics, &bar);
-                bar.finish_and_clear();
-                multi.remove(&bar);
+                let frames = E::process(&session, &file.params, &file.topics, bar.as_ref());
+                drop(bar);
                 let frames = frames?;
                 store(&opts.out, &dir, &key, &frames, &provenance)?;
                 Ok((frames, false))
@@ -423,7 +408,7 @@ pub fn run_experiment<E: Experiment>(
             }
         })
         .collect();
-    total.finish_and_clear();
+    drop(total);
     let (computed, cached) = counts.into_inner().unwrap_or_default();
     summary.computed = computed;
     summary.cached = cached;

@@ -26,14 +26,13 @@ pub mod world;
 
 use std::path::{Path, PathBuf};
 
-use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
 pub use scenario::{Scenario, ScenarioError};
 pub use session::SynthError;
 
 /// Where and how to synthesize.
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 pub struct SynthOptions {
     pub profile: String,
     /// Folder for the session logs (default: the scenario's folder, `full/` below it for the
@@ -41,7 +40,8 @@ pub struct SynthOptions {
     pub out: Option<PathBuf>,
     /// Folder for `<name>/preview.png` (none: no preview).
     pub preview_root: Option<PathBuf>,
-    pub progress: bool,
+    /// Progress bars (`None`: silent).
+    pub progress: crate::progress::SharedReporter,
 }
 
 /// What was written.
@@ -74,25 +74,16 @@ pub fn synthesize(scenario_path: &Path, opts: &SynthOptions) -> anyhow::Result<S
     let base = scenario_path
         .parent()
         .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
-    let multi = MultiProgress::new();
-    if !opts.progress {
-        multi.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-    }
-    let style =
-        ProgressStyle::with_template("{prefix:>24} [{bar:30}] {pos}/{len} sensor frames {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> ");
+    let bars = crate::progress::reporter(&opts.progress);
     let results: Vec<anyhow::Result<(PathBuf, Option<session::PreviewData>)>> = (0..s
         .scenario
         .sessions)
         .into_par_iter()
         .map(|k| {
             let path = out.join(format!("{}_{:02}.mcap", s.scenario.name, k));
-            let bar = multi.add(ProgressBar::new(0));
-            bar.set_style(style.clone());
-            bar.set_prefix(format!("{} {k}", s.scenario.name));
-            let preview = session::write_session(&s, &text, &opts.profile, &base, k, &path, &bar)?;
-            bar.finish_and_clear();
+            let bar = bars.bar(&format!("{} {k}", s.scenario.name), "sensor frames");
+            let preview =
+                session::write_session(&s, &text, &opts.profile, &base, k, &path, bar.as_ref())?;
             Ok((path, (k == 0).then_some(preview)))
         })
         .collect();

@@ -9,8 +9,8 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use crate::progress::Progress;
 use image::RgbImage;
-use indicatif::ProgressBar;
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use rand::RngExt;
 use serde::Serialize;
@@ -460,7 +460,7 @@ pub fn write_session(
     base: &Path,
     index: u32,
     path: &Path,
-    bar: &ProgressBar,
+    bar: &dyn Progress,
 ) -> Result<PreviewData, SynthError> {
     let seed = rng::hash(s.scenario.seed, &[u64::from(index)]);
     let session = u64::from(index);

@@ -7,9 +7,9 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use crate::progress::Progress;
 use anyhow::{Context, bail};
 use image::RgbImage;
-use indicatif::ProgressBar;
 use nalgebra::{Point2, Point3};
 use polars::prelude::*;
 use rayon::prelude::*;
@@ -20,7 +20,7 @@ use crate::geometry::triangulate::{CalibratedView, triangulate_dlt};
 use crate::groundtruth::PeopleFrame;
 use crate::log::msgs::{CameraInfo, CompressedImage, Detection2DArray, Image};
 use crate::log::{Decoders, Message, SessionLog, TfBuffer, read_topic};
-use crate::run::{Frames, Session};
+use crate::run::{Session, SessionTables};
 use crate::time::Nanos;
 use crate::track::cylinders::{self, Cylinder, CylinderParams, CylinderTracker, Selection};
 use crate::track::graph_match::{Box2d, GraphParams, GraphTracker};
@@ -556,8 +556,8 @@ pub(crate) fn process(
     s: &Session,
     p: &Params,
     t: &Topics,
-    bar: &ProgressBar,
-) -> anyhow::Result<Frames> {
+    bar: &dyn Progress,
+) -> anyhow::Result<SessionTables> {
     let log = &s.log;
     let file = log.path().display().to_string();
     let calib = read_calibration(log, p, t)?;
@@ -1174,7 +1174,7 @@ pub(crate) fn process(
         }
         df! { "camera" => cam, "x_m" => x, "y_m" => y, "z_m" => z, "heading_rad" => heading }?
     };
-    Ok(Frames::from([
+    Ok(SessionTables::from([
         ("calibration".to_string(), calib_df),
         ("tracks".to_string(), tracks_df),
         ("gt".to_string(), gt_df),
