@@ -19,7 +19,7 @@ help:
 	@echo "make opencv-agreement  pixel agreement of vision::gmm masks with OpenCV MOG2 (throwaway venv)"
 	@echo "make bench-mlp         appearance-model training (10 splits) beside scikit-learn MLPRegressor, with the ratio"
 	@echo "make bench-gmm         adaptive GMM frames/s beside OpenCV MOG2 on the same frames, with ratios"
-	@echo "make bench-multicam    seed 004: frames/s of the whole multicam_cylinders pipeline per camera and of the Gabor background alone"
+	@echo "make bench-multicam    seed 004: frames/s of the whole s004_mohedano_multicam pipeline per camera and of the Gabor background alone"
 	@echo "make clean     remove build outputs and out/"
 
 release:
@@ -56,7 +56,7 @@ bench: $(VENV)/ok
 	$(MAKE) bench-mlp
 	$(MAKE) bench-multicam
 
-# Seed 004: the whole multicam_cylinders processing per camera frame and the Gabor stage alone
+# Seed 004: the whole s004_mohedano_multicam processing per camera frame and the Gabor stage alone
 # (a 2 s multicam_office session is synthesized into target/bench-data/ on first use).
 bench-multicam:
 	$(CARGO) bench --bench multicam -- --noplot

@@ -1,6 +1,6 @@
 //! Seed 004 throughput (`make bench`): frames per second of the Gabor background stage alone
 //! (16 filters + running average + MAD threshold, one 352x288 camera, decoded frames), and of
-//! the whole `multicam_cylinders` per-session processing — JPEG decode, Gabor background,
+//! the whole `s004_mohedano_multicam` per-session processing — JPEG decode, Gabor background,
 //! template detection, 2-D graph matching for four cameras (cameras in parallel), then the 3-D
 //! cylinder stage — reported per camera frame (camera-frames/s: divide by four for
 //! multi-camera frames/s).
@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use peopletrack::log::msgs::CompressedImage;
 use peopletrack::log::{SessionLog, read_topic};
-use peopletrack::pipelines::multicam_cylinders::{MulticamCylinders, Params};
+use peopletrack::pipelines::s004_mohedano_multicam::{MulticamCylinders, Params};
 use peopletrack::run::config::SessionRef;
 use peopletrack::run::{Experiment, Session};
 use peopletrack::synth::{SynthOptions, synthesize};
@@ -56,7 +56,7 @@ fn session() -> PathBuf {
 }
 
 fn params() -> Params {
-    let text = std::fs::read_to_string(root().join("pipelines/multicam_cylinders.toml"))
+    let text = std::fs::read_to_string(root().join("pipelines/s004_mohedano_multicam.toml"))
         .expect("pipeline");
     let v: toml::Value = toml::from_str(&text).expect("toml");
     let mut p: Params = v

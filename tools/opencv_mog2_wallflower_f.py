@@ -1,5 +1,5 @@
 """OpenCV MOG2's F-measure on Wallflower WavingTrees frame 247 (the reference row of the
-`background_tracking` pipeline's wallflower table; the pipeline itself never runs Python).
+`s003_zivkovic_background` pipeline's wallflower table; the pipeline itself never runs Python).
 
     target/py-venv/bin/python tools/opencv_mog2_wallflower_f.py ../shared/real/wallflower_waving_trees/WavingTrees
 

@@ -1,7 +1,7 @@
 //! `peopletrack train omni-appearance --sessions GLOB`: learn an appearance model from your own
 //! logs and save it (network, feature normalisation, provenance) for `peopletrack run` to load.
 //!
-//! Training is the E1 pipeline run on the given sessions: the webcam measurement system is
+//! Training is the s000_cielniak_omni pipeline run on the given sessions: the webcam measurement system is
 //! calibrated on the calibration segment and provides the distances the network learns, and
 //! the usual tables (calibration, ANN error over random splits, ...) are written as well, so a
 //! model never comes without its own evaluation.
@@ -37,7 +37,7 @@ pub struct OmniArgs {
     #[arg(long, value_name = "GLOB", required = true)]
     pub sessions: Vec<String>,
     /// Pipeline file with the settings (webcams, hat colour, panorama, network size, epochs).
-    #[arg(long, default_value = "pipelines/omni_appearance.toml")]
+    #[arg(long, default_value = "pipelines/s000_cielniak_omni.toml")]
     pub config: PathBuf,
     /// Where to write the trained model (JSON).
     #[arg(long, short, default_value = "models/omni_appearance.json")]

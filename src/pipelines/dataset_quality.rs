@@ -16,7 +16,7 @@ use crate::log::stats::{StatsOptions, topic_stats};
 use crate::report::figure::{FigureKind, LinePlot, Series};
 use crate::report::{Figure, Table};
 
-use super::columns::{concat as stack, f64s as col_f64, strs as col_str};
+use crate::report::columns::{concat as stack, f64s as col_f64, strs as col_str};
 use crate::run::config::Invalid;
 use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
 

@@ -1,43 +1,41 @@
 //! The experiments, one module each, and the registry that maps a pipeline file's `kind` to
 //! its implementation.
 
-pub mod background_tracking;
-pub mod columns;
 pub mod dataset_quality;
-pub mod multicam_cylinders;
-pub mod omni_appearance;
+pub mod s000_cielniak_omni;
+pub mod s003_zivkovic_background;
+pub mod s004_mohedano_multicam;
 
 use std::path::Path;
 
 use crate::run::{Experiment, RunOptions, RunSummary, config, run_experiment, unknown_kind};
 
-/// Every `pipeline.kind` this build knows.
-pub const KINDS: &[&str] = &[
-    background_tracking::BackgroundTracking::KIND,
-    dataset_quality::DatasetQuality::KIND,
-    multicam_cylinders::MulticamCylinders::KIND,
-    omni_appearance::OmniAppearance::KIND,
-];
+/// The one list of experiments: each type's `KIND` is listed in [`KINDS`] and dispatched by
+/// [`run_file`].
+macro_rules! registry {
+    ($($ty:path),* $(,)?) => {
+        /// Every `pipeline.kind` this build knows.
+        pub const KINDS: &[&str] = &[$(<$ty as Experiment>::KIND),*];
 
-/// Run one pipeline file, dispatching on its `kind`.
-pub fn run_file(path: &Path, opts: &RunOptions) -> anyhow::Result<RunSummary> {
-    let (text, kind) = config::read_kind(path)?;
-    match kind.as_str() {
-        background_tracking::BackgroundTracking::KIND => {
-            run_experiment::<background_tracking::BackgroundTracking>(path, &text, opts)
+        /// Run one pipeline file, dispatching on its `kind`.
+        pub fn run_file(path: &Path, opts: &RunOptions) -> anyhow::Result<RunSummary> {
+            let (text, kind) = config::read_kind(path)?;
+            $(
+                if kind == <$ty as Experiment>::KIND {
+                    return run_experiment::<$ty>(path, &text, opts);
+                }
+            )*
+            Err(unknown_kind(path, &kind, KINDS).into())
         }
-        dataset_quality::DatasetQuality::KIND => {
-            run_experiment::<dataset_quality::DatasetQuality>(path, &text, opts)
-        }
-        multicam_cylinders::MulticamCylinders::KIND => {
-            run_experiment::<multicam_cylinders::MulticamCylinders>(path, &text, opts)
-        }
-        omni_appearance::OmniAppearance::KIND => {
-            run_experiment::<omni_appearance::OmniAppearance>(path, &text, opts)
-        }
-        _ => Err(unknown_kind(path, &kind, KINDS).into()),
-    }
+    };
 }
+
+registry!(
+    dataset_quality::DatasetQuality,
+    s000_cielniak_omni::OmniAppearance,
+    s003_zivkovic_background::BackgroundTracking,
+    s004_mohedano_multicam::MulticamCylinders,
+);
 
 #[cfg(test)]
 mod tests {

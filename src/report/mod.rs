@@ -2,7 +2,9 @@
 //! report, all written atomically under `out/`. Only this module and `log` touch files.
 
 pub mod atomic;
+pub mod columns;
 pub mod figure;
+pub mod rows;
 pub mod table;
 
 use std::path::{Path, PathBuf};

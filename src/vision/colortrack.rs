@@ -75,7 +75,7 @@ pub const DEFAULT_CUTOFF_SIGMA: f64 = 2.5;
 /// The paper's β ≈ 1.1 is the same quantity for a *1-D* Gaussian cut at ±2.5σ (1.097). With a
 /// 2-D elliptical cut-off, β = 1.1 makes every iteration shrink V by 1.1 / 1.168 = 0.94 where the
 /// weights are flat, so the region settles smaller than the object (measured in the tests and
-/// reported by the `background_tracking` pipeline beside the paper's value).
+/// reported by the `s003_zivkovic_background` pipeline beside the paper's value).
 pub fn consistent_beta(cutoff_sigma: f64) -> f64 {
     let c2 = cutoff_sigma * cutoff_sigma;
     let tail = (-0.5 * c2).exp();

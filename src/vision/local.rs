@@ -91,7 +91,7 @@ pub enum LocalError {
     },
 }
 
-/// Parameters; [`Default`] gives the values in `pipelines/background_tracking.toml`.
+/// Parameters; [`Default`] gives the values in `pipelines/s003_zivkovic_background.toml`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct LocalParams {

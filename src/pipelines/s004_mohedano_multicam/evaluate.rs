@@ -25,7 +25,7 @@ use crate::run::{Aggregate, Products};
 /// Frame numbers and identities of session `s` are offset by `s · STRIDE`.
 const STRIDE: i64 = 1_000_000_000;
 
-pub(super) use crate::pipelines::columns::{bools, f64s, i64s, opt_f64s, strs};
+pub(super) use crate::report::columns::{bools, f64s, i64s, opt_f64s, strs};
 
 /// The tracks table of one session, by column.
 #[derive(Debug, Clone, Default)]

@@ -1,4 +1,4 @@
-//! The `background_tracking` pipeline end to end on a tiny synthesized scene: a fixed camera
+//! The `s003_zivkovic_background` pipeline end to end on a tiny synthesized scene: a fixed camera
 //! with exact masks, a plant swaying, one person walking towards the camera. Checks that every
 //! table and figure is written, known properties of the numbers (a lower c_thr can only add
 //! foreground pixels, so TP % and FP % fall as c_thr grows; the EM-like tracker follows the
@@ -62,8 +62,8 @@ fn pipeline(wallflower: &str) -> String {
     format!(
         r#"
 [pipeline]
-name = "background_tracking"
-kind = "background_tracking"
+name = "s003_zivkovic_background"
+kind = "s003_zivkovic_background"
 title = "E4 test"
 
 [inputs]
@@ -156,8 +156,8 @@ fn pipeline_end_to_end_on_a_tiny_scene() {
     run(&toml, &sessions, &o1, "1");
     run(&toml, &sessions, &o2, "2");
     let (a, b) = (
-        files(&o1.join("background_tracking")),
-        files(&o2.join("background_tracking")),
+        files(&o1.join("s003_zivkovic_background")),
+        files(&o2.join("s003_zivkovic_background")),
     );
     for name in [
         "tables/roc.csv",
@@ -329,8 +329,9 @@ fn bad_logs_are_skipped_or_counted_naming_file_and_topic() {
         text.contains("truncated") && text.contains("no_image"),
         "{text}"
     );
-    let sessions = std::fs::read_to_string(out.join("background_tracking/tables/sessions.csv"))
-        .expect("sessions table");
+    let sessions =
+        std::fs::read_to_string(out.join("s003_zivkovic_background/tables/sessions.csv"))
+            .expect("sessions table");
     let row = sessions
         .lines()
         .find(|l| l.contains("bad_jpeg"))

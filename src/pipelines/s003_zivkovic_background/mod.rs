@@ -1,4 +1,4 @@
-//! `background_tracking` (E4, seed 003): the two COGNIRON vision methods of Zivkovic (ICPR
+//! `s003_zivkovic_background` (seed 003): the two COGNIRON vision methods of Zivkovic (ICPR
 //! 2004) and Zivkovic & Kröse (CVPR 2004) on the home-tour background scenes, and the local
 //! tracks built from them.
 //!
@@ -38,7 +38,6 @@ use polars::prelude::*;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::columns::{f64s as col_f64, i64s as col_i64, opt_f64s as col_opt_f64, strs as col_str};
 use crate::Nanos;
 use crate::eval::mot::{self, BoxPx, Geometry, MatchRule, Metrics};
 use crate::eval::stats::{Summary, describe, paired_t};
@@ -47,6 +46,9 @@ use crate::log::image::{decode_compressed, decode_raw};
 use crate::log::msgs::{CompressedImage, Image, Odometry};
 use crate::log::tf::{TfBuffer, normalize_frame};
 use crate::log::{Decoders, SessionLog, read_topic};
+use crate::report::columns::{
+    f64s as col_f64, i64s as col_i64, opt_f64s as col_opt_f64, strs as col_str,
+};
 use crate::report::figure::{
     Bar, BarPlot, FigureKind, ImageOverlay, LinePlot, Mark, Overlay, Series,
 };
@@ -198,7 +200,7 @@ impl Default for WallflowerParams {
     }
 }
 
-/// `[params]` of `pipelines/background_tracking.toml`.
+/// `[params]` of `pipelines/s003_zivkovic_background.toml`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Params {
@@ -639,7 +641,7 @@ fn image_from_frame(df: &DataFrame, width: u32, height: u32) -> anyhow::Result<R
 }
 
 impl Experiment for BackgroundTracking {
-    const KIND: &'static str = "background_tracking";
+    const KIND: &'static str = "s003_zivkovic_background";
     // 2: EM-like stop rule (settled boundary), ROC datasets can be excluded
     const VERSION: u32 = 2;
     type Params = Params;

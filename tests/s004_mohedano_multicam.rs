@@ -1,4 +1,4 @@
-//! `multicam_cylinders` end to end through the CLI on a short session of the `multicam_office`
+//! `s004_mohedano_multicam` end to end through the CLI on a short session of the `multicam_office`
 //! scenario (seed 004): the ground-truth 2-D boxes of the log, written as
 //! `vision_msgs/msg/Detection2DArray` per camera, go through the "bring your own detector" path
 //! (`detector = "log"`) into the 3-D stage, which must reach MOTA ≥ 0.95; `--write-tracks`
@@ -147,13 +147,13 @@ fn fixture() -> &'static Fixture {
         for p in &s.sessions {
             with_gt_detections(p, &byod.join(p.file_name().expect("name")), None);
         }
-        let text = std::fs::read_to_string(root().join("pipelines/multicam_cylinders.toml"))
+        let text = std::fs::read_to_string(root().join("pipelines/s004_mohedano_multicam.toml"))
             .expect("pipeline");
         let text = text
             .replace("detector = \"templates\"", "detector = \"log\"")
             .replace("gt_boxes = true", "gt_boxes = false");
         assert!(text.contains("detector = \"log\"") && text.contains("gt_boxes = false"));
-        let pipeline = base.join("multicam_cylinders.toml");
+        let pipeline = base.join("s004_mohedano_multicam.toml");
         std::fs::write(&pipeline, text).expect("pipeline");
         Fixture {
             sessions: format!("{}/*.mcap", byod.display()),
@@ -205,7 +205,7 @@ fn csv(path: &Path) -> Vec<BTreeMap<String, String>> {
 
 fn tables(out: &Path) -> BTreeMap<String, Vec<u8>> {
     let mut m = BTreeMap::new();
-    let d = out.join("multicam_cylinders/tables");
+    let d = out.join("s004_mohedano_multicam/tables");
     for e in std::fs::read_dir(&d).expect("tables exist") {
         let p = e.expect("entry").path();
         m.insert(
@@ -231,7 +231,7 @@ fn ground_truth_boxes_through_the_log_detector_path_reach_mota_095_and_tracks_re
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 
-    let rows = csv(&out.join("multicam_cylinders/tables/clear_mot.csv"));
+    let rows = csv(&out.join("s004_mohedano_multicam/tables/clear_mot.csv"));
     let mut seen = 0;
     for r in rows.iter().filter(|r| r["detector"] == "log") {
         let mota: f64 = r["MOTA"].parse().expect("MOTA");

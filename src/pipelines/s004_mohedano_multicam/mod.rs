@@ -1,4 +1,4 @@
-//! `multicam_cylinders`: seed 004 (Mohedano et al.) end to end — Gabor-feature background
+//! `s004_mohedano_multicam`: seed 004 (Mohedano et al.) end to end — Gabor-feature background
 //! subtraction with a MAD threshold (§2), silhouette-template detection (§3), 2-D tracking by
 //! graph matching (§4) and the multi-camera geometry-based 3-D tracker that models people as
 //! cylinders (§5) — on calibrated cameras (`CameraInfo` + TF), with the paper's evaluation
@@ -15,7 +15,7 @@
 //! `vision_msgs/msg/Detection2DArray` per camera ("bring your own detector").
 //!
 //! Outputs: the tracks (per frame, per person: position, height, radius, supporting cameras,
-//! `E_m`), tables and figures under `out/multicam_cylinders/`, and with `write_tracks` the
+//! `E_m`), tables and figures under `out/s004_mohedano_multicam/`, and with `write_tracks` the
 //! tracks written back into a copy of each log as `visualization_msgs/msg/MarkerArray`
 //! (cylinders and labels in the world frame) that Foxglove's 3-D and image panels draw over
 //! the cameras.
@@ -59,7 +59,7 @@ pub enum BackgroundUpdate {
     Selective,
 }
 
-/// `[params]` of `pipelines/multicam_cylinders.toml`; the file says where each default comes
+/// `[params]` of `pipelines/s004_mohedano_multicam.toml`; the file says where each default comes
 /// from.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -213,7 +213,7 @@ pub(crate) fn topics(p: &Params, remap: &BTreeMap<String, String>) -> Topics {
 }
 
 impl Experiment for MulticamCylinders {
-    const KIND: &'static str = "multicam_cylinders";
+    const KIND: &'static str = "s004_mohedano_multicam";
     const VERSION: u32 = 1;
     type Params = Params;
 
@@ -385,7 +385,7 @@ mod tests {
     #[test]
     fn the_shipped_pipeline_file_states_the_code_defaults_and_bad_values_are_named() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("pipelines/multicam_cylinders.toml");
+            .join("pipelines/s004_mohedano_multicam.toml");
         let text = std::fs::read_to_string(&path).expect("pipeline file");
         let mut file = config::parse::<Params>(&path, &text).expect("parses");
         assert!(MulticamCylinders::validate(&file.params).is_empty());

@@ -49,7 +49,7 @@ fn pipeline(dir: &Path, name: &str, sessions: &str, extra: &str) -> PathBuf {
     std::fs::write(
         &path,
         format!(
-            "[pipeline]\nname = \"{name}\"\nkind = \"omni_appearance\"\ntitle = \"E1 test\"\ndescription = \"test\"\n\
+            "[pipeline]\nname = \"{name}\"\nkind = \"s000_cielniak_omni\"\ntitle = \"E1 test\"\ndescription = \"test\"\n\
              [inputs]\nsessions = [\"{sessions}\"]\n[params]\nsplits = 3\nepochs = 500\nsweep_hidden = [2, 4]\n\
              sweep_learning_rates = [0.3]\nsweep_splits = 1\n{extra}\n"
         ),
@@ -74,7 +74,7 @@ fn calibrates_learns_tracks_and_the_saved_model_reproduces_its_estimates() {
     )
     .expect("synthesizes");
     let glob = format!("{}/*.mcap", logs.display());
-    let train = pipeline(dir.path(), "omni_appearance", &glob, "");
+    let train = pipeline(dir.path(), "s000_cielniak_omni", &glob, "");
 
     // the same run on 1 and 2 threads: byte-identical tables
     let outs: Vec<PathBuf> = [1usize, 2]
@@ -187,5 +187,5 @@ fn calibrates_learns_tracks_and_the_saved_model_reproduces_its_estimates() {
 }
 
 fn outs_dir(out: &Path) -> PathBuf {
-    out.join("omni_appearance")
+    out.join("s000_cielniak_omni")
 }

@@ -1,4 +1,4 @@
-//! E1 — appearance-based tracking with an omnidirectional camera (seed 000, Cielniak et al.
+//! `s000_cielniak_omni` — appearance-based tracking with an omnidirectional camera (seed 000, Cielniak et al.
 //! 2003), every step on the logged images:
 //!
 //! 1. **External measurement system** (section 3): webcams find the green hat, turn its column
@@ -29,7 +29,6 @@ use rand::seq::SliceRandom;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::columns::{bools, concat, f64s, i64s, strs};
 use crate::calib::external::{self, BearingCamera, Sample};
 use crate::eval::stats::{self, DEFAULT_LEVEL};
 use crate::geometry::camera::CameraModel;
@@ -37,6 +36,7 @@ use crate::groundtruth::{PEOPLE_TOPIC, PeopleFrame, TARGETS_TOPIC, TargetsFrame}
 use crate::learn::mlp::{Regressor, TrainSpec};
 use crate::log::msgs::{CameraInfo, CompressedImage, Image};
 use crate::log::{SessionLog, TfBuffer, read_topic};
+use crate::report::columns::{bools, concat, f64s, i64s, strs};
 use crate::report::figure::{
     Circle, FigureKind, LinePlot, Mark, ScatterPlot, Sensor, Series, TopView,
 };
@@ -49,7 +49,7 @@ use crate::vision::omni::{Background, Unwrapper, features};
 
 pub struct OmniAppearance;
 
-/// `[params]` of `pipelines/omni_appearance.toml`.
+/// `[params]` of `pipelines/s000_cielniak_omni.toml`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Params {
@@ -81,7 +81,7 @@ pub struct Params {
     pub max_gap_s: f64,
     /// Use a trained model file instead of training (empty: train).
     pub model: String,
-    /// Also save the general model trained on all data here (relative to out/omni_appearance/).
+    /// Also save the general model trained on all data here (relative to out/s000_cielniak_omni/).
     pub save_model: String,
 }
 
@@ -176,7 +176,7 @@ fn first_info(log: &SessionLog, name: &str) -> anyhow::Result<CameraInfo> {
 }
 
 impl Experiment for OmniAppearance {
-    const KIND: &'static str = "omni_appearance";
+    const KIND: &'static str = "s000_cielniak_omni";
     const VERSION: u32 = 1;
     type Params = Params;
 
@@ -587,7 +587,7 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             estimates_csv(ctx, &get("omni")?, &model.regressor)?,
         ));
         out.summary.push(format!(
-            "Positions estimated with {} written to out/omni_appearance/estimates.csv.",
+            "Positions estimated with {} written to out/s000_cielniak_omni/estimates.csv.",
             p.model
         ));
         return Ok(out);
@@ -1394,7 +1394,7 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
         .push(("estimates.csv".into(), estimates_csv(ctx, &omni, &general)?));
     if loaded.is_none() && !p.save_model.is_empty() {
         let model = AppearanceModel {
-            kind: "omni_appearance".into(),
+            kind: "s000_cielniak_omni".into(),
             version: 1,
             features: names3.iter().map(|s| (*s).to_string()).collect(),
             regressor: general,
@@ -1413,7 +1413,7 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             serde_json::to_vec_pretty(&model)?,
         ));
         out.summary.push(format!(
-            "General model trained on all {} frames saved to out/omni_appearance/{}.",
+            "General model trained on all {} frames saved to out/s000_cielniak_omni/{}.",
             rows.len(),
             p.save_model
         ));
