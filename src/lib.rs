@@ -4,6 +4,7 @@
 //! detections and tracks, and evaluation turns tracks into tables and figures. See
 //! `ARCHITECTURE.md` for the map.
 
+pub mod assign;
 pub mod calib;
 pub mod cli;
 pub mod eval;
@@ -11,9 +12,11 @@ pub mod geometry;
 pub mod groundtruth;
 pub mod learn;
 pub mod log;
+pub mod names;
 pub mod pipelines;
 pub mod progress;
 pub mod report;
+pub mod rng;
 pub mod run;
 pub mod synth;
 pub mod time;

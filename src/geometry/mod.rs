@@ -3,6 +3,7 @@
 //! cameras use the optical frame (x right, y down, z forward).
 
 pub mod camera;
+pub mod rect;
 pub mod triangulate;
 
 use nalgebra::{Isometry3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};

@@ -175,7 +175,7 @@ impl Regressor {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::rng;
+    use crate::rng;
 
     #[test]
     fn gradient_matches_finite_differences() {

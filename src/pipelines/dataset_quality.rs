@@ -3,6 +3,7 @@
 //! statistics (people, speeds, visibility) where the session has them. Runs on any log,
 //! synthetic or real; it is the first thing to look at before trusting an experiment's numbers.
 
+use crate::names::sanitize;
 use std::collections::BTreeMap;
 
 use crate::progress::Progress;
@@ -296,16 +297,4 @@ impl Experiment for DatasetQuality {
         }
         Ok(products)
     }
-}
-
-fn sanitize(s: &str) -> String {
-    s.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
 }

@@ -91,6 +91,12 @@ pub trait Experiment: Sync {
     /// The stages and the topics they read, with `[topics]` remaps applied.
     fn plan(params: &Self::Params, topics: &BTreeMap<String, String>) -> Vec<Stage>;
 
+    /// Files outside the session logs that `aggregate` reads (e.g. a real reference sequence),
+    /// listed in the plan. Aggregation reads nothing else but the cached session tables.
+    fn external_inputs(_params: &Self::Params) -> Vec<PathBuf> {
+        Vec::new()
+    }
+
     /// Process one session into named tables.
     fn process(
         session: &Session,
@@ -259,6 +265,18 @@ fn plan_text<E: Experiment>(
                 format!(", uses if present [{}]", s.optional.join(", "))
             }
         );
+    }
+    let inputs = E::external_inputs(&file.params);
+    if !inputs.is_empty() {
+        let _ = writeln!(o, "other inputs (read by aggregation):");
+        for p in inputs {
+            let state = if p.exists() {
+                "present"
+            } else {
+                "absent: SKIPPED"
+            };
+            let _ = writeln!(o, "  {}  ({state})", p.display());
+        }
     }
     let _ = writeln!(
         o,

@@ -5,8 +5,8 @@
 
 use nalgebra::{Isometry3, Point3, Vector3};
 
-use super::rng;
 use super::world::Primitive;
+use crate::rng;
 
 /// Laser parameters.
 #[derive(Debug, Clone)]

@@ -17,7 +17,7 @@ pub mod motion;
 pub mod person;
 pub mod preview;
 pub mod render;
-pub mod rng;
+pub use crate::rng;
 pub mod robot;
 pub mod scenario;
 pub mod session;

@@ -284,7 +284,7 @@ pub fn replay(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::rng;
+    use crate::rng;
 
     #[test]
     fn walker_reaches_goals_at_human_speed_and_pauses() {

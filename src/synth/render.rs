@@ -16,10 +16,10 @@ use nalgebra::{Isometry3, Point2, Point3, Vector3};
 use rayon::prelude::*;
 
 use super::person::shadow_factor;
-use super::rng;
 use super::shapes::Shape;
 use super::world::{Primitive, World, sky};
 use crate::geometry::camera::{CameraModel, Ray};
+use crate::rng;
 
 const TILE: usize = 16;
 /// Primitives larger than this (m) are tested at every pixel rather than binned.

@@ -10,8 +10,8 @@ use rand::RngExt;
 use rand_distr::{Distribution, Normal};
 
 use super::motion::{DT, Track};
-use super::rng;
 use super::scenario::{Robot, RobotMode};
+use crate::rng;
 
 /// Robot state at one instant.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

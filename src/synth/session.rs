@@ -19,7 +19,6 @@ use super::laser::{LaserSpec, scan};
 use super::motion::{self, Goal, Track};
 use super::person::{Body, PersonState};
 use super::render::{Camera, FrameInput};
-use super::rng;
 use super::robot::{self, RobotTrack};
 use super::scenario::{
     ImageFormat, Motion, MountFrame, PersonSpec, RobotMode, Scenario, SensorSpec,
@@ -33,6 +32,7 @@ use crate::log::msgs::{
     Transform, TransformStamped,
 };
 use crate::log::{ChannelId, LogError, SessionWriter, WriterOptions};
+use crate::rng;
 use crate::time::Nanos;
 
 /// Version of the generator, recorded in every log's metadata.

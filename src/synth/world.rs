@@ -6,9 +6,9 @@
 use nalgebra::{Point3, Vector3};
 use rand::RngExt;
 
-use super::rng;
 use super::scenario::{DynamicSpec, Light, Rgb, Scenario, TextureSpec, WorldKind};
 use super::shapes::Shape;
+use crate::rng;
 
 /// Object ids: 0 is static background, 1..PERSON_BASE moving background, PERSON_BASE + id a person.
 pub const PERSON_BASE: u32 = 1000;

@@ -20,7 +20,7 @@
 use nalgebra::{Matrix2, Matrix2x4, Vector2, Vector4};
 
 use super::kalman::{Kalman, constant_velocity_2d};
-use crate::eval::mot::assign::max_score_pairs;
+use crate::assign::max_score_pairs;
 
 /// One detection handed to the 2-D tracker (from the template detector or any other).
 #[derive(Debug, Clone, Copy, PartialEq)]

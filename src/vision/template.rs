@@ -47,6 +47,7 @@
 //! What it does not do: no learned shapes, no per-position template choice (the whole set is
 //! tried everywhere), no sub-pixel positions (the search stride is a parameter).
 
+use crate::geometry::rect::{contained, iou};
 use nalgebra::Point3;
 
 use super::gabor::Mask;
@@ -527,25 +528,6 @@ fn score_at(
     }
     let mse = (f64::from(t1) - 2.0 * f64::from(c) + sw) / area;
     Some(1.0 - mse)
-}
-
-fn iou(a: &[f64; 4], b: &[f64; 4]) -> f64 {
-    let iw = (a[2].min(b[2]) - a[0].max(b[0])).max(0.0);
-    let ih = (a[3].min(b[3]) - a[1].max(b[1])).max(0.0);
-    let inter = iw * ih;
-    if inter <= 0.0 {
-        return 0.0;
-    }
-    let area = |r: &[f64; 4]| (r[2] - r[0]) * (r[3] - r[1]);
-    inter / (area(a) + area(b) - inter)
-}
-
-/// Fraction of box `a`'s area inside box `b`.
-fn contained(a: &[f64; 4], b: &[f64; 4]) -> f64 {
-    let iw = (a[2].min(b[2]) - a[0].max(b[0])).max(0.0);
-    let ih = (a[3].min(b[3]) - a[1].max(b[1])).max(0.0);
-    let area = (a[2] - a[0]) * (a[3] - a[1]);
-    if area <= 0.0 { 0.0 } else { iw * ih / area }
 }
 
 /// Detect people in a foreground mask with a template set, every template at every position.

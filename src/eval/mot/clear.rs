@@ -2,7 +2,7 @@
 //! (with `max_switch_time = ∞`) and the counts of `metrics.py`.
 
 use super::Frame;
-use super::assign::min_cost_max_pairs;
+use crate::assign::min_cost_max_pairs;
 
 /// An object is mostly tracked when matched in at least this share of its frames (Li et al.,
 /// CVPR 2009; motmetrics `mostly_tracked`).

@@ -19,7 +19,7 @@
 use std::collections::HashMap;
 
 use super::Frame;
-use super::assign::max_score_pairs;
+use crate::assign::max_score_pairs;
 
 /// Number of localisation thresholds α.
 pub const HOTA_ALPHAS: usize = 19;

@@ -11,7 +11,7 @@
 use std::collections::HashMap;
 
 use super::Frame;
-use super::assign::max_count_pairs;
+use crate::assign::max_count_pairs;
 
 /// IDF1 and its parts. Ratios are NaN where their denominator is zero.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]

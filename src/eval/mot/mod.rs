@@ -42,7 +42,7 @@
 //! sequences. motmetrics' Matlab offset (bb_left/top − 1 on load) is not applied: it cannot
 //! change an IoU. Nothing here opens files: the CSV functions take and return text.
 
-pub mod assign;
+pub use crate::assign;
 mod clear;
 mod error;
 mod hota;

@@ -41,9 +41,9 @@ use crate::report::figure::{
     Circle, FigureKind, LinePlot, Mark, ScatterPlot, Sensor, Series, TopView,
 };
 use crate::report::{Figure, Table};
+use crate::rng;
 use crate::run::config::Invalid;
 use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
-use crate::synth::rng;
 use crate::track::position::{PositionKf, covariance};
 use crate::vision::omni::{Background, Unwrapper, features};
 

@@ -27,6 +27,7 @@
 //! tracker comparison with per-frame samples and paired t-tests, the local-track table, and
 //! the Wallflower WavingTrees F-measure (real data, read from `wallflower.dir` when present).
 
+use crate::names::sanitize;
 use std::collections::{BTreeMap, VecDeque};
 use std::path::Path;
 use std::time::Instant;
@@ -1176,18 +1177,6 @@ fn session_value_i64(frames: &SessionTables, name: &str) -> i64 {
         .and_then(|d| col_i64(d, name).ok())
         .and_then(|v| v.first().copied())
         .unwrap_or(0)
-}
-
-fn sanitize(s: &str) -> String {
-    s.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
 }
 
 /// Datasets in first-seen order with their sessions.

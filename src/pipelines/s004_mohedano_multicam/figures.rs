@@ -1,6 +1,7 @@
 //! Figures: the bird's-eye view with trajectories and cylinders (paper fig. 5c/6c) and the
 //! four camera views with the projected cylinders (fig. 5a/b/d/e).
 
+use crate::names::sanitize;
 use image::RgbImage;
 use nalgebra::Point3;
 
@@ -235,16 +236,4 @@ pub(super) fn camera_views(s: &Scored, p: &Params) -> anyhow::Result<Option<Figu
             shapes,
         }),
     )))
-}
-
-pub(super) fn sanitize(s: &str) -> String {
-    s.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
 }

@@ -4,6 +4,7 @@
 // Tables are built column by column in tuples of vectors, one per column.
 #![allow(clippy::type_complexity)]
 
+use crate::geometry::rect::iou;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -326,17 +327,6 @@ struct HeadCentroidCols {
     min_visibility: Vec<f64>,
     head_error_m: Vec<f64>,
     centroid_error_m: Vec<f64>,
-}
-
-fn iou(a: &[f64; 4], b: &[f64; 4]) -> f64 {
-    let iw = (a[2].min(b[2]) - a[0].max(b[0])).max(0.0);
-    let ih = (a[3].min(b[3]) - a[1].max(b[1])).max(0.0);
-    let inter = iw * ih;
-    if inter <= 0.0 {
-        return 0.0;
-    }
-    let area = |r: &[f64; 4]| (r[2] - r[0]).max(0.0) * (r[3] - r[1]).max(0.0);
-    inter / (area(a) + area(b) - inter)
 }
 
 /// A template detection matches a ground-truth person when its head point is within this many
