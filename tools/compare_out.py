@@ -7,7 +7,7 @@ Compares each `tables/*.{csv,md,tex}` and the other CSV outputs (e.g. `estimates
 pipeline folder. `--rename` maps a pipeline folder name of the first tree to the second's (a
 pipeline that was renamed). Ignored: `Provenance:` lines (they carry the git commit) and the
 timing tables, which are measurements (`timing_*`). Prints one line per file and a closing
-`N passed, N failed` line; exits 1 when anything differs or is missing.
+`N passed, N failed` line; `--only NAME` limits the check to some pipelines; exits 1 when anything differs or is missing.
 """
 import argparse
 import pathlib
@@ -39,11 +39,14 @@ def main() -> int:
     ap.add_argument("before", type=pathlib.Path)
     ap.add_argument("after", type=pathlib.Path)
     ap.add_argument("--rename", action="append", default=[], metavar="OLD=NEW")
+    ap.add_argument("--only", action="append", default=[], metavar="NAME", help="compare only these pipeline folders (names in the first tree)")
     a = ap.parse_args()
     rename = dict(r.split("=", 1) for r in a.rename)
     passed = failed = 0
     seen_after = set()
     for rel in table_files(a.before):
+        if a.only and rel.parts[0] not in a.only:
+            continue
         target = pathlib.Path(rename.get(rel.parts[0], rel.parts[0]), *rel.parts[1:])
         seen_after.add(target)
         other = a.after / target
@@ -55,7 +58,10 @@ def main() -> int:
             failed += 1
         else:
             passed += 1
+    only_after = {rename.get(o, o) for o in a.only}
     for rel in table_files(a.after):
+        if a.only and rel.parts[0] not in only_after:
+            continue
         if rel not in seen_after:
             print(f"NEW      {rel}")
     print(f"{passed} passed, {failed} failed")

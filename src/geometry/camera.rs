@@ -22,8 +22,6 @@
 
 use nalgebra::{Point2, Point3, Vector3};
 
-use crate::log::msgs::{CameraInfo, Header};
-
 /// A ray in the camera frame: `origin + t · dir`, `dir` unit length.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ray {
@@ -314,97 +312,6 @@ impl CameraModel {
         let (w, h) = self.size();
         px.x >= 0.0 && px.y >= 0.0 && px.x < f64::from(w) && px.y < f64::from(h)
     }
-
-    /// The `CameraInfo` that describes this model.
-    pub fn camera_info(&self, header: Header) -> CameraInfo {
-        let (width, height) = self.size();
-        let (model, d, (fx, fy, cx, cy)) = match self {
-            CameraModel::Pinhole(c) => ("plumb_bob", c.dist.to_vec(), (c.fx, c.fy, c.cx, c.cy)),
-            CameraModel::Paracatadioptric(c) => (
-                "paracatadioptric",
-                vec![c.xc, c.yc, c.f, c.r_min, c.r_max],
-                (c.f, c.f, c.xc, c.yc),
-            ),
-            CameraModel::ConicalMirror(c) => (
-                "conical_mirror",
-                vec![c.xc, c.yc, c.f, c.d, c.alpha, c.z_top],
-                (c.f, c.f, c.xc, c.yc),
-            ),
-        };
-        CameraInfo {
-            header,
-            height,
-            width,
-            distortion_model: model.to_string(),
-            d,
-            k: [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0],
-            r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
-            p: [fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0],
-            ..Default::default()
-        }
-    }
-
-    /// Read a model from a `CameraInfo`.
-    pub fn from_camera_info(info: &CameraInfo) -> Result<CameraModel, CameraError> {
-        let need = |n: usize| {
-            if info.d.len() < n {
-                Err(CameraError::Coefficients {
-                    model: info.distortion_model.clone(),
-                    need: n,
-                    have: info.d.len(),
-                })
-            } else {
-                Ok(())
-            }
-        };
-        if info.width == 0 || info.height == 0 || info.k[0] == 0.0 {
-            return Err(CameraError::Degenerate);
-        }
-        let (width, height) = (info.width, info.height);
-        match info.distortion_model.as_str() {
-            "plumb_bob" | "" => {
-                let mut dist = [0.0; 5];
-                for (slot, v) in dist.iter_mut().zip(&info.d) {
-                    *slot = *v;
-                }
-                Ok(CameraModel::Pinhole(Pinhole {
-                    width,
-                    height,
-                    fx: info.k[0],
-                    fy: info.k[4],
-                    cx: info.k[2],
-                    cy: info.k[5],
-                    dist,
-                }))
-            }
-            "paracatadioptric" => {
-                need(3)?;
-                Ok(CameraModel::Paracatadioptric(Paracatadioptric {
-                    width,
-                    height,
-                    xc: info.d[0],
-                    yc: info.d[1],
-                    f: info.d[2],
-                    r_min: info.d.get(3).copied().unwrap_or(0.0),
-                    r_max: info.d.get(4).copied().unwrap_or(f64::INFINITY),
-                }))
-            }
-            "conical_mirror" => {
-                need(6)?;
-                Ok(CameraModel::ConicalMirror(ConicalMirror {
-                    width,
-                    height,
-                    xc: info.d[0],
-                    yc: info.d[1],
-                    f: info.d[2],
-                    d: info.d[3],
-                    alpha: info.d[4],
-                    z_top: info.d[5],
-                }))
-            }
-            other => Err(CameraError::UnknownModel(other.to_string())),
-        }
-    }
 }
 
 #[cfg(test)]
@@ -540,23 +447,5 @@ mod tests {
             assert!((ray.origin.x.hypot(ray.origin.y) - on_cone).abs() < 1e-12);
         }
         check_round_trip(&CameraModel::ConicalMirror(c), &grid((-1.6, 0.0)));
-    }
-
-    #[test]
-    fn camera_info_round_trip() {
-        for m in [
-            CameraModel::Pinhole(pinhole()),
-            CameraModel::Paracatadioptric(para()),
-            CameraModel::ConicalMirror(cone()),
-        ] {
-            let info = m.camera_info(Header::default());
-            assert_eq!(CameraModel::from_camera_info(&info).expect("reads"), m);
-        }
-        let mut bad = CameraModel::Pinhole(pinhole()).camera_info(Header::default());
-        bad.distortion_model = "fisheye".into();
-        assert!(matches!(
-            CameraModel::from_camera_info(&bad),
-            Err(CameraError::UnknownModel(_))
-        ));
     }
 }

@@ -10,6 +10,7 @@
 //! - [`tf`]: the transform tree with interpolated lookups; [`sync`]: nearest-stamp joins.
 //! - [`writer`]: sessions as `ros2 bag record` writes them; [`definitions`]: their schemas.
 
+mod camera_info;
 pub mod cdr;
 pub mod decode;
 pub mod definitions;

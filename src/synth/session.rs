@@ -647,7 +647,7 @@ pub fn write_session(
                     nominal_yaw_deg: heading_deg(&nominal, optical),
                     true_xyz: pose.translation.vector.into(),
                     true_yaw_deg: heading_deg(&pose, optical),
-                    model: model.camera_info(Header::default()).distortion_model,
+                    model: CameraInfo::from_model(&model, Header::default()).distortion_model,
                 });
                 let image_ch = match camera.format {
                     ImageFormat::Raw => {
@@ -920,7 +920,11 @@ pub fn write_session(
                             )?;
                         }
                     }
-                    w.write(channels.1, log, &cam.model.camera_info(header.clone()))?;
+                    w.write(
+                        channels.1,
+                        log,
+                        &CameraInfo::from_model(&cam.model, header.clone()),
+                    )?;
                     if *mask && let Some(ch) = channels.2 {
                         let data: Vec<u8> = frame
                             .ids

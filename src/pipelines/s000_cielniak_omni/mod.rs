@@ -361,7 +361,8 @@ impl Experiment for OmniAppearance {
         // omni: unwrap, background, features
         bar.set_message("omni features");
         let info = first_info(log, &p.omni)?;
-        let model = CameraModel::from_camera_info(&info)
+        let model = info
+            .model()
             .with_context(|| format!("/{}/camera_info", p.omni))?;
         let (xc, yc, rim) = match &model {
             CameraModel::ConicalMirror(c) => (c.xc, c.yc, c.r_rim()),

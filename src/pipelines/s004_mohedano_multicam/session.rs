@@ -16,7 +16,6 @@ use polars::prelude::*;
 use rayon::prelude::*;
 
 use super::{BackgroundUpdate, Detector, Params, Topics};
-use crate::geometry::camera::CameraModel;
 use crate::geometry::triangulate::{CalibratedView, triangulate_dlt};
 use crate::groundtruth::PeopleFrame;
 use crate::log::msgs::{CameraInfo, CompressedImage, Detection2DArray, Image};
@@ -66,7 +65,8 @@ pub(crate) fn read_calibration(
         let (_, info) = read_topic::<CameraInfo>(log, topic)?
             .next()
             .with_context(|| format!("{file}: no CameraInfo on {topic}"))??;
-        let model = CameraModel::from_camera_info(&info)
+        let model = info
+            .model()
             .with_context(|| format!("{file}: {topic}: camera {cam}"))?;
         let frame = if info.header.frame_id.is_empty() {
             cam.clone()
