@@ -6,7 +6,6 @@
 
 pub mod assign;
 pub mod calib;
-pub mod cli;
 pub mod eval;
 pub mod geometry;
 pub mod groundtruth;

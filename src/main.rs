@@ -1,5 +1,8 @@
-//! The `peopletrack` binary: everything lives in the library; see `peopletrack --help`.
+//! The `peopletrack` binary: the command line (clap) and terminal progress bars (indicatif) live
+//! here, in [`cli`]; everything else is the `peopletrack` library. See `peopletrack --help`.
+
+mod cli;
 
 fn main() -> std::process::ExitCode {
-    peopletrack::cli::main()
+    cli::main()
 }

@@ -1,6 +1,6 @@
 //! Progress of long steps, as the library reports it: a small trait that the binary implements
-//! with terminal progress bars (`cli::progress`) and tests leave silent. The library never
-//! draws anything itself.
+//! with terminal progress bars (`src/cli/progress.rs`, indicatif) and tests leave silent. The
+//! library never draws anything itself.
 
 use std::sync::Arc;
 

@@ -7,7 +7,7 @@
 
 use std::path::PathBuf;
 
-use crate::log::{Decoders, SessionLog};
+use peopletrack::log::{Decoders, SessionLog};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {

@@ -7,9 +7,9 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use crate::pipelines;
-use crate::report::atomic;
-use crate::run::{RunOptions, report};
+use peopletrack::pipelines;
+use peopletrack::report::atomic;
+use peopletrack::run::{RunOptions, report};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {

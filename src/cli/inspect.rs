@@ -8,8 +8,8 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use crate::log::stats::{StatsOptions, TopicStats, topic_stats};
-use crate::log::{LogError, SessionLog, TfBuffer};
+use peopletrack::log::stats::{StatsOptions, TopicStats, topic_stats};
+use peopletrack::log::{LogError, SessionLog, TfBuffer};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {

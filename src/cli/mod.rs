@@ -1,5 +1,6 @@
-//! Command-line interface: parsing (clap) and one module per subcommand. `main.rs` only calls
-//! [`main`]; errors become exit codes here, in one place.
+//! Command-line interface of the binary (not part of the library): parsing (clap), terminal
+//! progress bars (indicatif) and one module per subcommand, all through `peopletrack::…`.
+//! `main.rs` only calls [`main`]; errors become exit codes here, in one place.
 
 pub mod cat;
 pub mod eval;
@@ -72,7 +73,7 @@ pub fn main() -> ExitCode {
         return ExitCode::FAILURE;
     }
     if let Some(n) = cli.debug_abort_after_writes {
-        crate::report::atomic::abort_before_rename(n);
+        peopletrack::report::atomic::abort_before_rename(n);
     }
     let stdout = io::stdout();
     let mut out = io::BufWriter::new(stdout.lock());

@@ -1,9 +1,9 @@
-//! Terminal progress bars (indicatif) behind the library's [`crate::progress`] traits. Only the
-//! command line draws; the library reports through the traits.
+//! Terminal progress bars (indicatif) behind the library's [`peopletrack::progress`] traits.
+//! Only the binary draws; the library reports through the traits.
 
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::progress::{Progress, Reporter};
+use peopletrack::progress::{Progress, Reporter};
 
 /// Bars stacked on stderr, one per session in flight.
 pub struct Bars {
@@ -64,6 +64,6 @@ impl Reporter for Bars {
 }
 
 /// A shared reporter for options: bars on stderr when it is a terminal.
-pub fn shared(visible: bool) -> crate::progress::SharedReporter {
+pub fn shared(visible: bool) -> peopletrack::progress::SharedReporter {
     Some(std::sync::Arc::new(Bars::new(visible)))
 }

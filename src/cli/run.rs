@@ -3,9 +3,9 @@
 
 use std::path::PathBuf;
 
-use crate::pipelines;
-use crate::report::atomic;
-use crate::run::RunOptions;
+use peopletrack::pipelines;
+use peopletrack::report::atomic;
+use peopletrack::run::RunOptions;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {

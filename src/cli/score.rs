@@ -1,12 +1,12 @@
 //! `peopletrack score --gt GT.csv --hyp HYP.csv (--iou T | --dist-m D) [--json]`: tracking
 //! metrics of one hypothesis file against its ground truth (MOTChallenge CSV), through
-//! [`crate::eval::mot`]. `run` reads the files; [`render_text`] is pure.
+//! [`peopletrack::eval::mot`]. `run` reads the files; [`render_text`] is pure.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use crate::eval::mot::{self, GeometryKind, MatchRule, Metrics, Observation};
+use peopletrack::eval::mot::{self, GeometryKind, MatchRule, Metrics, Observation};
 
 const HELP: &str = "\
 Input: MOTChallenge CSV, one row per object per frame:

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use crate::synth::{self, SynthOptions};
+use peopletrack::synth::{self, SynthOptions};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {

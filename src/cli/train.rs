@@ -10,9 +10,9 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use crate::pipelines;
-use crate::report::atomic;
-use crate::run::RunOptions;
+use peopletrack::pipelines;
+use peopletrack::report::atomic;
+use peopletrack::run::RunOptions;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
