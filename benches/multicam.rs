@@ -47,7 +47,6 @@ fn session() -> PathBuf {
         &SynthOptions {
             profile: "quick".into(),
             out: Some(dir.clone()),
-            preview_root: None,
             progress: None,
         },
     )

@@ -68,7 +68,6 @@ fn calibrates_learns_tracks_and_the_saved_model_reproduces_its_estimates() {
         &SynthOptions {
             profile: "quick".into(),
             out: Some(logs.clone()),
-            preview_root: Some(dir.path().join("preview")),
             progress: None,
         },
     )

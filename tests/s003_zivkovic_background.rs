@@ -99,7 +99,6 @@ fn synth(dir: &Path) -> PathBuf {
         &SynthOptions {
             profile: "quick".into(),
             out: Some(out.clone()),
-            preview_root: None,
             progress: None,
         },
     )

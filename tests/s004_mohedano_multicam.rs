@@ -136,7 +136,6 @@ fn fixture() -> &'static Fixture {
             &SynthOptions {
                 profile: "quick".into(),
                 out: Some(base.join("synth/multicam_office")),
-                preview_root: None,
                 progress: None,
             },
         )

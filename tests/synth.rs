@@ -7,13 +7,17 @@ use std::path::{Path, PathBuf};
 use peopletrack::groundtruth::PeopleFrame;
 use peopletrack::log::msgs::{CompressedImage, Image, LaserScan};
 use peopletrack::log::{Decoders, SessionLog, read_topic};
-use peopletrack::synth::{SynthOptions, synthesize};
+use peopletrack::synth::{SynthOptions, SynthSummary, synthesize};
 
 fn scenario() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny_scenario.toml")
 }
 
 fn synth_into(dir: &Path, threads: usize) -> Vec<PathBuf> {
+    synth_summary(dir, threads).sessions
+}
+
+fn synth_summary(dir: &Path, threads: usize) -> SynthSummary {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -24,19 +28,18 @@ fn synth_into(dir: &Path, threads: usize) -> Vec<PathBuf> {
             &SynthOptions {
                 profile: "quick".into(),
                 out: Some(dir.to_path_buf()),
-                preview_root: Some(dir.join("preview")),
                 progress: None,
             },
         )
         .expect("synthesizes")
-        .sessions
     })
 }
 
 #[test]
 fn same_scenario_and_seed_give_identical_bytes_whatever_the_thread_count() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let a = synth_into(&dir.path().join("one"), 1);
+    let one = synth_summary(&dir.path().join("one"), 1);
+    let a = one.sessions;
     let b = synth_into(&dir.path().join("three"), 3);
     assert_eq!(a.len(), 2);
     for (x, y) in a.iter().zip(&b) {
@@ -52,7 +55,14 @@ fn same_scenario_and_seed_give_identical_bytes_whatever_the_thread_count() {
         std::fs::read(&a[0]).expect("a0"),
         std::fs::read(&a[1]).expect("a1")
     );
-    assert!(dir.path().join("one/preview/tiny/preview.png").exists());
+    // the synthesizer returns the preview's data; report draws the sheet
+    let data = one.preview.expect("preview data of session 0");
+    assert_eq!(data.cameras.len(), 3, "one tile per camera");
+    let root = dir.path().join("one/preview");
+    let sheet = peopletrack::report::preview::write(&root, "tiny", &data).expect("sheet");
+    assert_eq!(sheet, root.join("tiny/preview.png"));
+    let png = image::open(&sheet).expect("a PNG");
+    assert!(png.width() > 100 && png.height() > 100);
 }
 
 #[test]

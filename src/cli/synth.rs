@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 
+use peopletrack::report::preview;
 use peopletrack::synth::{self, SynthOptions};
 
 #[derive(Debug, clap::Args)]
@@ -49,10 +50,13 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
             &SynthOptions {
                 profile: a.profile.clone(),
                 out: a.out.clone(),
-                preview_root: Some(a.preview.clone()),
                 progress: super::progress::shared(super::stderr_is_terminal()),
             },
         )?;
+        let sheet = match &s.preview {
+            Some(data) => Some(preview::write(&a.preview, &s.name, data)?),
+            None => None,
+        };
         writeln!(
             out,
             "{}: {} sessions in {:.1} s",
@@ -63,7 +67,7 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         for p in &s.sessions {
             writeln!(out, "  {}", p.display())?;
         }
-        if let Some(p) = &s.preview {
+        if let Some(p) = &sheet {
             writeln!(out, "  preview {}", p.display())?;
         }
     }

@@ -4,6 +4,7 @@
 pub mod atomic;
 pub mod columns;
 pub mod figure;
+pub mod preview;
 pub mod rows;
 pub mod table;
 

@@ -6,7 +6,8 @@
 //! - [`world`]: static scene, moving background, materials and light; [`shapes`]: primitives.
 //! - [`person`]: articulated people; [`motion`]: how they move; [`robot`]: the robot.
 //! - [`render`]: per-pixel ray casting for every camera model; [`laser`]: scans.
-//! - [`session`]: one session written as a log; [`preview`]: the preview sheet.
+//! - [`session`]: one session written as a log, returning what its preview sheet shows
+//!   ([`PreviewData`]; `report::preview` draws the sheet — the synthesizer draws nothing).
 //! - [`rng`]: seeded randomness.
 //!
 //! Not modelled: global illumination, cast shadows other than soft floor shadows under people,
@@ -15,7 +16,6 @@
 pub mod laser;
 pub mod motion;
 pub mod person;
-pub mod preview;
 pub mod render;
 pub use crate::rng;
 pub mod robot;
@@ -29,7 +29,7 @@ use std::path::{Path, PathBuf};
 use rayon::prelude::*;
 
 pub use scenario::{Scenario, ScenarioError};
-pub use session::SynthError;
+pub use session::{PreviewData, SynthError};
 
 /// Where and how to synthesize.
 #[derive(Clone)]
@@ -38,18 +38,16 @@ pub struct SynthOptions {
     /// Folder for the session logs (default: the scenario's folder, `full/` below it for the
     /// full profile).
     pub out: Option<PathBuf>,
-    /// Folder for `<name>/preview.png` (none: no preview).
-    pub preview_root: Option<PathBuf>,
     /// Progress bars (`None`: silent).
     pub progress: crate::progress::SharedReporter,
 }
 
-/// What was written.
-#[derive(Debug, Clone)]
+/// What was written, and what the preview sheet of the dataset shows.
 pub struct SynthSummary {
     pub name: String,
     pub sessions: Vec<PathBuf>,
-    pub preview: Option<PathBuf>,
+    /// One instant of the first session (none when the scenario has no sessions).
+    pub preview: Option<PreviewData>,
 }
 
 /// Default folder of a profile's logs.
@@ -96,16 +94,9 @@ pub fn synthesize(scenario_path: &Path, opts: &SynthOptions) -> anyhow::Result<S
             first_preview = pv;
         }
     }
-    let mut preview = None;
-    if let (Some(root), Some(pv)) = (&opts.preview_root, first_preview) {
-        let path = root.join(&s.scenario.name).join("preview.png");
-        let png = preview::sheet(&s.scenario.name, &pv)?;
-        crate::report::atomic::write_atomic(&path, &png, Some(root))?;
-        preview = Some(path);
-    }
     Ok(SynthSummary {
         name: s.scenario.name.clone(),
         sessions,
-        preview,
+        preview: first_preview,
     })
 }

@@ -1,20 +1,42 @@
 //! The preview sheet of a dataset (`out/datasets/<name>/preview.png`): one frame of every
 //! camera with the ground truth drawn over it (boxes, head points, ids), and the laser scan
 //! from above with the room, obstacles, sensors and people — so a person can see what was made.
+//!
+//! The synthesizer only returns the data ([`PreviewData`], one instant of a dataset's first
+//! session); drawing and writing it is this module's job.
+
+use std::path::{Path, PathBuf};
 
 use image::{RgbImage, imageops};
 
-use super::session::PreviewData;
-use crate::report::figure::{
-    Circle, Figure, FigureKind, ImageOverlay, Mark, Overlay, Sensor, Series, TopView,
+use super::atomic;
+use super::figure::{
+    Circle, Figure, FigureError, FigureKind, ImageOverlay, Mark, Overlay, Sensor, Series, TopView,
 };
+use crate::synth::session::PreviewData;
 
 fn decode(png: &[u8]) -> Option<RgbImage> {
     image::load_from_memory(png).ok().map(|i| i.to_rgb8())
 }
 
+/// Where the sheet of dataset `name` goes under `root`: `<root>/<name>/preview.png`.
+pub fn path(root: &Path, name: &str) -> PathBuf {
+    root.join(name).join("preview.png")
+}
+
+/// Compose the sheet of dataset `name` and write it atomically to [`path`]; returns the path.
+pub fn write(root: &Path, name: &str, p: &PreviewData) -> Result<PathBuf, FigureError> {
+    let path = path(root, name);
+    let png = sheet(name, p)?;
+    atomic::write_atomic(&path, &png, Some(root)).map_err(|e| FigureError {
+        name: name.into(),
+        reason: e.to_string(),
+    })?;
+    Ok(path)
+}
+
 /// Compose the sheet as PNG bytes.
-pub fn sheet(name: &str, p: &PreviewData) -> Result<Vec<u8>, crate::report::figure::FigureError> {
+pub fn sheet(name: &str, p: &PreviewData) -> Result<Vec<u8>, FigureError> {
     let mut tiles: Vec<RgbImage> = Vec::new();
     for (cam, img, views) in &p.cameras {
         let mut shapes = Vec::new();
@@ -156,7 +178,7 @@ pub fn sheet(name: &str, p: &PreviewData) -> Result<Vec<u8>, crate::report::figu
     let mut out = Vec::new();
     canvas
         .write_to(&mut std::io::Cursor::new(&mut out), image::ImageFormat::Png)
-        .map_err(|e| crate::report::figure::FigureError {
+        .map_err(|e| FigureError {
             name: name.into(),
             reason: e.to_string(),
         })?;
