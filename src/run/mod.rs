@@ -10,15 +10,20 @@
 //! 3. **Aggregate**: the experiment's `aggregate` reads every session's tables and returns
 //!    result tables and figures, written under `out/<pipeline>/{tables,figures}/`.
 //!
-//! A session that cannot be processed (unreadable log, missing topic) is skipped, counted and
-//! listed with its reason in the run summary and the report — never silently dropped.
+//! 4. **Write**: the products go under `out/<pipeline>/` atomically, listed in the summary.
+//!
+//! A session that cannot be processed (unreadable log, missing topic, a panic in `process`) is
+//! skipped, counted and listed with its reason in the run summary and the report — never
+//! silently dropped; the other sessions' results are kept. The cache lives in `cache`
+//! (`--aggregate-only` reads it without the logs).
 
+mod cache;
 pub mod config;
 pub mod report;
 
 use std::collections::BTreeMap;
+use std::panic::{self, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 use std::time::Instant;
 
 use anyhow::Context;
@@ -26,11 +31,9 @@ use polars::prelude::DataFrame;
 use rayon::prelude::*;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
-use xxhash_rust::xxh3::Xxh3;
 
 use crate::log::SessionLog;
 use crate::progress::{Progress, SharedReporter, reporter};
-use crate::report::table::{parquet_bytes, read_parquet};
 use crate::report::{Figure, Provenance, Table, atomic, table::write_table, write_figure};
 use config::{ConfigError, Invalid, PipelineFile, SessionRef};
 
@@ -151,82 +154,6 @@ pub struct RunSummary {
     pub plan: String,
 }
 
-/// Hash of a file's bytes (xxh3-128, streamed).
-fn hash_file(path: &Path) -> std::io::Result<u128> {
-    use std::io::Read;
-    let mut f = std::fs::File::open(path)?;
-    let mut h = Xxh3::new();
-    let mut buf = vec![0u8; 1 << 20];
-    loop {
-        let n = f.read(&mut buf)?;
-        if n == 0 {
-            break;
-        }
-        h.update(&buf[..n]);
-    }
-    Ok(h.digest128())
-}
-
-fn session_dir(out: &Path, pipeline: &str, s: &SessionRef) -> PathBuf {
-    out.join(pipeline)
-        .join("sessions")
-        .join(&s.dataset)
-        .join(&s.name)
-}
-
-const KEY_FILE: &str = "key.txt";
-
-/// Load cached frames if the key matches.
-fn load_cached(dir: &Path, key: &str) -> Option<SessionTables> {
-    let stored = std::fs::read_to_string(dir.join(KEY_FILE)).ok()?;
-    if stored.trim() != key {
-        return None;
-    }
-    let mut frames = SessionTables::new();
-    for entry in std::fs::read_dir(dir).ok()? {
-        let p = entry.ok()?.path();
-        if p.extension().is_some_and(|e| e == "parquet") {
-            let name = p.file_stem()?.to_string_lossy().into_owned();
-            frames.insert(name, read_parquet(&p).ok()?);
-        }
-    }
-    Some(frames)
-}
-
-/// Write a session's frames: into a scratch folder first, key last, then swap it into place.
-fn store(
-    out: &Path,
-    dir: &Path,
-    key: &str,
-    frames: &SessionTables,
-    prov: &Provenance,
-) -> anyhow::Result<()> {
-    let tag = xxhash_rust::xxh3::xxh3_64(dir.to_string_lossy().as_bytes());
-    let scratch = out
-        .join(atomic::SCRATCH_DIR)
-        .join(format!("session-{}-{tag:016x}", std::process::id()));
-    if scratch.exists() {
-        std::fs::remove_dir_all(&scratch)?;
-    }
-    std::fs::create_dir_all(&scratch)?;
-    for (name, df) in frames {
-        std::fs::write(
-            scratch.join(format!("{name}.parquet")),
-            parquet_bytes(df, prov)?,
-        )?;
-    }
-    std::fs::write(scratch.join(KEY_FILE), key)?;
-    if dir.exists() {
-        std::fs::remove_dir_all(dir)?;
-    }
-    atomic::maybe_abort_hook();
-    if let Some(parent) = dir.parent() {
-        std::fs::create_dir_all(parent)?;
-    }
-    std::fs::rename(&scratch, dir)?;
-    Ok(())
-}
-
 /// Check that a session has every required topic.
 fn missing_topics(log: &SessionLog, stages: &[Stage]) -> Vec<String> {
     let mut missing: Vec<String> = stages
@@ -307,13 +234,20 @@ fn plan_text<E: Experiment>(
     o
 }
 
-/// Run one pipeline file end to end with experiment `E`.
-pub fn run_experiment<E: Experiment>(
+/// Step 1, the plan: the parsed pipeline file, its stages and the sessions to run.
+struct Plan<P> {
+    file: PipelineFile<P>,
+    stages: Vec<Stage>,
+    /// The session globs in force (the file's, or `--sessions`).
+    patterns: Vec<String>,
+    sessions: Vec<SessionRef>,
+}
+
+fn plan<E: Experiment>(
     path: &Path,
     text: &str,
     opts: &RunOptions,
-) -> anyhow::Result<RunSummary> {
-    let started = Instant::now();
+) -> anyhow::Result<Plan<E::Params>> {
     let file: PipelineFile<E::Params> = config::parse(path, text)?;
     config::check(path, text, E::validate(&file.params))?;
     let stages = E::plan(&file.params, &file.topics);
@@ -322,6 +256,24 @@ pub fn run_experiment<E: Experiment>(
         .clone()
         .unwrap_or_else(|| file.inputs.sessions.clone());
     let mut sessions = config::find_sessions(&patterns, &file.inputs.exclude)?;
+    if opts.aggregate_only {
+        // sessions whose logs are gone but whose results are cached
+        let cached = cache::cached_sessions(
+            &opts.out,
+            &file.pipeline.name,
+            &patterns,
+            &file.inputs.exclude,
+        );
+        for c in cached {
+            if !sessions
+                .iter()
+                .any(|s| s.dataset == c.dataset && s.name == c.name)
+            {
+                sessions.push(c);
+            }
+        }
+        sessions.sort();
+    }
     if let Some((k, n)) = opts.shard {
         sessions = sessions
             .into_iter()
@@ -330,12 +282,183 @@ pub fn run_experiment<E: Experiment>(
             .map(|(_, s)| s)
             .collect();
     }
+    Ok(Plan {
+        file,
+        stages,
+        patterns,
+        sessions,
+    })
+}
+
+/// Where tables come from: provenance of every table and cached file of this run.
+fn provenance(sessions: &[SessionRef], git_commit: &str, params_json: &str) -> Provenance {
+    let mut d: Vec<&str> = sessions.iter().map(|s| s.dataset.as_str()).collect();
+    d.dedup();
+    Provenance {
+        dataset: format!("{} ({} sessions)", d.join(", "), sessions.len()),
+        seed: None,
+        git_commit: git_commit.to_string(),
+        tool_version: env!("CARGO_PKG_VERSION").to_string(),
+        parameters: serde_json::from_str::<BTreeMap<String, serde_json::Value>>(params_json)
+            .unwrap_or_default()
+            .into_iter()
+            .map(|(k, v)| (k, v.to_string()))
+            .collect(),
+    }
+}
+
+/// Everything one session's processing needs besides the session itself.
+struct SessionJob<'a, P> {
+    plan: &'a Plan<P>,
+    opts: &'a RunOptions,
+    pipeline: &'a str,
+    key: cache::KeyParts<'a>,
+    provenance: &'a Provenance,
+    bars: &'a dyn crate::progress::Reporter,
+}
+
+/// Step 2, one session: its cached tables when the key matches, else `process` (then cached).
+/// Returns the tables and whether they came from the cache.
+fn session_tables<E: Experiment>(
+    job: &SessionJob<E::Params>,
+    s: &SessionRef,
+) -> anyhow::Result<(SessionTables, bool)> {
+    let opts = job.opts;
+    let dir = cache::session_dir(&opts.out, job.pipeline, s);
+    let file_hash = if opts.aggregate_only && !s.path.exists() {
+        match cache::recorded_hash(&dir) {
+            Some(h) => h,
+            None => anyhow::bail!("no cached result for this session (run the shards first)"),
+        }
+    } else {
+        cache::hash_file(&s.path).with_context(|| format!("reading {}", s.path.display()))?
+    };
+    let key = job.key.key(file_hash);
+    if !opts.force
+        && let Some(tables) = cache::load(&dir, &key)
+    {
+        return Ok((tables, true));
+    }
+    if opts.aggregate_only {
+        anyhow::bail!("no cached result for this session (run the shards first)");
+    }
+    let log = SessionLog::open(&s.path)?;
+    let missing = missing_topics(&log, &job.plan.stages);
+    if !missing.is_empty() {
+        anyhow::bail!("missing topic(s) {}", missing.join(", "));
+    }
+    let bar = job.bars.bar(&format!("{}/{}", s.dataset, s.name), "");
+    let session = Session {
+        log,
+        info: s.clone(),
+    };
+    let file = &job.plan.file;
+    let tables = E::process(&session, &file.params, &file.topics, bar.as_ref());
+    drop(bar);
+    let tables = tables?;
+    cache::store(
+        &opts.out,
+        &dir,
+        &key,
+        (&s.path, file_hash),
+        &tables,
+        job.provenance,
+    )?;
+    Ok((tables, false))
+}
+
+/// The text of a panic's payload.
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = payload.downcast_ref::<&str>() {
+        (*s).to_string()
+    } else if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "(no message)".to_string()
+    }
+}
+
+/// One session's outcome: its tables and whether they were cached, or why it was skipped.
+type Outcome = Result<(SessionRef, SessionTables, bool), (SessionRef, String)>;
+
+/// Step 2, every session (in parallel): a session that fails or panics becomes a skip with
+/// its reason; the others' results are kept. Outcomes come back in session order.
+fn process_sessions<E: Experiment>(job: &SessionJob<E::Params>) -> Vec<Outcome> {
+    let sessions = &job.plan.sessions;
+    let total = job.bars.bar(job.pipeline, "sessions");
+    total.set_length(sessions.len() as u64);
+    let outcomes = sessions
+        .par_iter()
+        .map(|s| {
+            let outcome = panic::catch_unwind(AssertUnwindSafe(|| session_tables::<E>(job, s)))
+                .unwrap_or_else(|p| Err(anyhow::anyhow!("panicked: {}", panic_message(&*p))));
+            total.inc(1);
+            match outcome {
+                Ok((tables, cached)) => Ok((s.clone(), tables, cached)),
+                Err(e) => Err((s.clone(), format!("{e:#}"))),
+            }
+        })
+        .collect();
+    drop(total);
+    outcomes
+}
+
+/// Step 4: write the aggregation's tables, figures and other files; list them in `summary`.
+fn write_products(
+    products: Products,
+    out: &Path,
+    provenance: &Provenance,
+    summary: &mut RunSummary,
+) -> anyhow::Result<()> {
+    let name = summary.pipeline.clone();
+    let pipeline_dir = out.join(&name);
+    for t in products.tables {
+        let t = if t.provenance.git_commit.is_empty() {
+            t.with_provenance(provenance.clone())
+        } else {
+            t
+        };
+        write_table(&pipeline_dir.join("tables"), &t, out)?;
+        summary
+            .tables
+            .push((t.title.clone(), format!("{name}/tables/{}.md", t.name)));
+    }
+    for f in products.figures {
+        write_figure(&pipeline_dir.join("figures"), &f, out)?;
+        summary
+            .figures
+            .push((f.title.clone(), format!("{name}/figures/{}.png", f.name)));
+    }
+    for (path, bytes) in &products.artifacts {
+        let path = if path.is_absolute() {
+            path.clone()
+        } else {
+            pipeline_dir.join(path)
+        };
+        atomic::write_atomic(&path, bytes, Some(out))
+            .with_context(|| format!("writing {}", path.display()))?;
+        summary.artifacts.push(path.display().to_string());
+    }
+    summary.summary = products.summary;
+    Ok(())
+}
+
+/// Run one pipeline file end to end with experiment `E`: plan, per-session processing
+/// (cached), aggregation, and writing of its products.
+pub fn run_experiment<E: Experiment>(
+    path: &Path,
+    text: &str,
+    opts: &RunOptions,
+) -> anyhow::Result<RunSummary> {
+    let started = Instant::now();
+    let plan = plan::<E>(path, text, opts)?;
+    let file = &plan.file;
     let name = file.pipeline.name.clone();
     let mut summary = RunSummary {
         pipeline: name.clone(),
         title: file.pipeline.title.clone(),
         file: path.display().to_string(),
-        sessions: sessions.len(),
+        sessions: plan.sessions.len(),
         computed: 0,
         cached: 0,
         skipped: Vec::new(),
@@ -347,93 +470,39 @@ pub fn run_experiment<E: Experiment>(
         plan: String::new(),
     };
     if opts.dry_run {
-        summary.plan = plan_text::<E>(&file, &sessions, &stages);
+        summary.plan = plan_text::<E>(file, &plan.sessions, &plan.stages);
         return Ok(summary);
     }
-    if sessions.is_empty() {
-        anyhow::bail!("{}: no sessions match {:?}", path.display(), patterns);
+    if plan.sessions.is_empty() {
+        anyhow::bail!("{}: no sessions match {:?}", path.display(), plan.patterns);
     }
     let params_json = serde_json::to_string(&file.params)?;
     let topics_json = serde_json::to_string(&file.topics)?;
-    let provenance = Provenance {
-        dataset: {
-            let mut d: Vec<&str> = sessions.iter().map(|s| s.dataset.as_str()).collect();
-            d.dedup();
-            format!("{} ({} sessions)", d.join(", "), sessions.len())
+    let provenance = provenance(&plan.sessions, &opts.git_commit, &params_json);
+    let job = SessionJob {
+        plan: &plan,
+        opts,
+        pipeline: &name,
+        key: cache::KeyParts {
+            kind: E::KIND,
+            version: E::VERSION,
+            params_json: &params_json,
+            topics_json: &topics_json,
         },
-        seed: None,
-        git_commit: opts.git_commit.clone(),
-        tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        parameters: serde_json::from_str::<BTreeMap<String, serde_json::Value>>(&params_json)
-            .unwrap_or_default()
-            .into_iter()
-            .map(|(k, v)| (k, v.to_string()))
-            .collect(),
+        provenance: &provenance,
+        bars: reporter(&opts.progress),
     };
-
-    let bars = reporter(&opts.progress);
-    let total = bars.bar(&name, "sessions");
-    total.set_length(sessions.len() as u64);
-    let counts = Mutex::new((0usize, 0usize));
-    let results: Vec<Result<(SessionRef, SessionTables), (SessionRef, String)>> = sessions
-        .par_iter()
-        .map(|s| {
-            let dir = session_dir(&opts.out, &name, s);
-            let outcome = (|| -> anyhow::Result<(SessionTables, bool)> {
-                let file_hash =
-                    hash_file(&s.path).with_context(|| format!("reading {}", s.path.display()))?;
-                let mut h = Xxh3::new();
-                h.update(&file_hash.to_le_bytes());
-                h.update(E::KIND.as_bytes());
-                h.update(env!("CARGO_PKG_VERSION").as_bytes());
-                h.update(&E::VERSION.to_le_bytes());
-                h.update(params_json.as_bytes());
-                h.update(topics_json.as_bytes());
-                let key = format!("{:032x}", h.digest128());
-                if !opts.force
-                    && let Some(frames) = load_cached(&dir, &key)
-                {
-                    return Ok((frames, true));
-                }
-                if opts.aggregate_only {
-                    anyhow::bail!("no cached result for this session (run the shards first)");
-                }
-                let log = SessionLog::open(&s.path)?;
-                let missing = missing_topics(&log, &stages);
-                if !missing.is_empty() {
-                    anyhow::bail!("missing topic(s) {}", missing.join(", "));
-                }
-                let bar = bars.bar(&format!("{}/{}", s.dataset, s.name), "");
-                let session = Session {
-                    log,
-                    info: s.clone(),
-                };
-                let frames = E::process(&session, &file.params, &file.topics, bar.as_ref());
-                drop(bar);
-                let frames = frames?;
-                store(&opts.out, &dir, &key, &frames, &provenance)?;
-                Ok((frames, false))
-            })();
-            total.inc(1);
-            match outcome {
-                Ok((frames, cached)) => {
-                    if let Ok(mut c) = counts.lock() {
-                        if cached { c.1 += 1 } else { c.0 += 1 }
-                    }
-                    Ok((s.clone(), frames))
-                }
-                Err(e) => Err((s.clone(), format!("{e:#}"))),
-            }
-        })
-        .collect();
-    drop(total);
-    let (computed, cached) = counts.into_inner().unwrap_or_default();
-    summary.computed = computed;
-    summary.cached = cached;
     let mut done = Vec::new();
-    for r in results {
-        match r {
-            Ok(x) => done.push(x),
+    for outcome in process_sessions::<E>(&job) {
+        match outcome {
+            Ok((s, tables, cached)) => {
+                if cached {
+                    summary.cached += 1;
+                } else {
+                    summary.computed += 1;
+                }
+                done.push((s, tables));
+            }
             Err((s, reason)) => summary
                 .skipped
                 .push((format!("{}/{}", s.dataset, s.name), reason)),
@@ -453,6 +522,7 @@ pub fn run_experiment<E: Experiment>(
                 .map_or(String::new(), |s| format!("{}: {}", s.0, s.1))
         );
     }
+    // step 3: aggregate
     let products = E::aggregate(
         &Aggregate {
             sessions: &done,
@@ -461,35 +531,7 @@ pub fn run_experiment<E: Experiment>(
         },
         &file.params,
     )?;
-    let pipeline_dir = opts.out.join(&name);
-    for t in products.tables {
-        let t = if t.provenance.git_commit.is_empty() {
-            t.with_provenance(provenance.clone())
-        } else {
-            t
-        };
-        write_table(&pipeline_dir.join("tables"), &t, &opts.out)?;
-        summary
-            .tables
-            .push((t.title.clone(), format!("{name}/tables/{}.md", t.name)));
-    }
-    for f in products.figures {
-        write_figure(&pipeline_dir.join("figures"), &f, &opts.out)?;
-        summary
-            .figures
-            .push((f.title.clone(), format!("{name}/figures/{}.png", f.name)));
-    }
-    for (path, bytes) in &products.artifacts {
-        let path = if path.is_absolute() {
-            path.clone()
-        } else {
-            pipeline_dir.join(path)
-        };
-        atomic::write_atomic(&path, bytes, Some(&opts.out))
-            .with_context(|| format!("writing {}", path.display()))?;
-        summary.artifacts.push(path.display().to_string());
-    }
-    summary.summary = products.summary;
+    write_products(products, &opts.out, &provenance, &mut summary)?;
     summary.seconds = started.elapsed().as_secs_f64();
     Ok(summary)
 }
@@ -505,3 +547,6 @@ pub fn unknown_kind(path: &Path, kind: &str, known: &[&str]) -> ConfigError {
         known: known.join(", "),
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,181 @@
+//! The per-session Parquet cache: `out/<pipeline>/sessions/<dataset>/<session>/` holds one
+//! `<table>.parquet` per table, `source.txt` (the log's hash and path) and `key.txt`, written
+//! last. The key hashes the log's bytes, the experiment's kind and `VERSION`, the tool version,
+//! the parameters and the topic remaps: a result is reused only when all of them match.
+//!
+//! `--aggregate-only` needs no logs: a session whose log is absent is found through the path
+//! recorded in its `source.txt`, and its key is recomputed from the recorded hash.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use xxhash_rust::xxh3::Xxh3;
+
+use super::SessionTables;
+use super::config::SessionRef;
+use crate::report::table::{parquet_bytes, read_parquet};
+use crate::report::{Provenance, atomic};
+
+const KEY_FILE: &str = "key.txt";
+const SOURCE_FILE: &str = "source.txt";
+
+/// Hash of a file's bytes (xxh3-128, streamed).
+pub fn hash_file(path: &Path) -> std::io::Result<u128> {
+    let mut f = std::fs::File::open(path)?;
+    let mut h = Xxh3::new();
+    let mut buf = vec![0u8; 1 << 20];
+    loop {
+        let n = f.read(&mut buf)?;
+        if n == 0 {
+            break;
+        }
+        h.update(&buf[..n]);
+    }
+    Ok(h.digest128())
+}
+
+/// What a session's cached result depends on besides its log.
+pub struct KeyParts<'a> {
+    pub kind: &'a str,
+    pub version: u32,
+    pub params_json: &'a str,
+    pub topics_json: &'a str,
+}
+
+impl KeyParts<'_> {
+    /// The cache key of a log whose bytes hash to `file_hash`.
+    pub fn key(&self, file_hash: u128) -> String {
+        let mut h = Xxh3::new();
+        h.update(&file_hash.to_le_bytes());
+        h.update(self.kind.as_bytes());
+        h.update(env!("CARGO_PKG_VERSION").as_bytes());
+        h.update(&self.version.to_le_bytes());
+        h.update(self.params_json.as_bytes());
+        h.update(self.topics_json.as_bytes());
+        format!("{:032x}", h.digest128())
+    }
+}
+
+/// The cache folder of one session.
+pub fn session_dir(out: &Path, pipeline: &str, s: &SessionRef) -> PathBuf {
+    out.join(pipeline)
+        .join("sessions")
+        .join(&s.dataset)
+        .join(&s.name)
+}
+
+/// Cached tables if the stored key is `key`.
+pub fn load(dir: &Path, key: &str) -> Option<SessionTables> {
+    let stored = std::fs::read_to_string(dir.join(KEY_FILE)).ok()?;
+    if stored.trim() != key {
+        return None;
+    }
+    let mut tables = SessionTables::new();
+    for entry in std::fs::read_dir(dir).ok()? {
+        let p = entry.ok()?.path();
+        if p.extension().is_some_and(|e| e == "parquet") {
+            let name = p.file_stem()?.to_string_lossy().into_owned();
+            tables.insert(name, read_parquet(&p).ok()?);
+        }
+    }
+    Some(tables)
+}
+
+/// The log hash recorded with a cached result (none for caches without `source.txt`).
+pub fn recorded_hash(dir: &Path) -> Option<u128> {
+    let text = std::fs::read_to_string(dir.join(SOURCE_FILE)).ok()?;
+    u128::from_str_radix(text.lines().next()?.trim(), 16).ok()
+}
+
+/// Write a session's tables: into a scratch folder first, key last, then swap it into place.
+pub fn store(
+    out: &Path,
+    dir: &Path,
+    key: &str,
+    source: (&Path, u128),
+    tables: &SessionTables,
+    prov: &Provenance,
+) -> anyhow::Result<()> {
+    let tag = xxhash_rust::xxh3::xxh3_64(dir.to_string_lossy().as_bytes());
+    let scratch = out
+        .join(atomic::SCRATCH_DIR)
+        .join(format!("session-{}-{tag:016x}", std::process::id()));
+    if scratch.exists() {
+        std::fs::remove_dir_all(&scratch)?;
+    }
+    std::fs::create_dir_all(&scratch)?;
+    for (name, df) in tables {
+        std::fs::write(
+            scratch.join(format!("{name}.parquet")),
+            parquet_bytes(df, prov)?,
+        )?;
+    }
+    let (path, hash) = source;
+    std::fs::write(
+        scratch.join(SOURCE_FILE),
+        format!("{hash:032x}\n{}\n", path.display()),
+    )?;
+    std::fs::write(scratch.join(KEY_FILE), key)?;
+    if dir.exists() {
+        std::fs::remove_dir_all(dir)?;
+    }
+    atomic::maybe_abort_hook();
+    if let Some(parent) = dir.parent() {
+        std::fs::create_dir_all(parent)?;
+    }
+    std::fs::rename(&scratch, dir)?;
+    Ok(())
+}
+
+/// Sessions with a cached result under `out/<pipeline>/sessions/` whose recorded log path
+/// matches one of `patterns` and none of `exclude` (the logs themselves may be absent).
+pub fn cached_sessions(
+    out: &Path,
+    pipeline: &str,
+    patterns: &[String],
+    exclude: &[String],
+) -> Vec<SessionRef> {
+    let compile = |ps: &[String]| -> Vec<glob::Pattern> {
+        ps.iter()
+            .filter_map(|p| glob::Pattern::new(p).ok())
+            .collect()
+    };
+    let (patterns, exclude) = (compile(patterns), compile(exclude));
+    let opts = glob::MatchOptions {
+        require_literal_separator: true,
+        ..glob::MatchOptions::new()
+    };
+    let mut found = Vec::new();
+    let Ok(datasets) = std::fs::read_dir(out.join(pipeline).join("sessions")) else {
+        return found;
+    };
+    for d in datasets.flatten() {
+        let Ok(sessions) = std::fs::read_dir(d.path()) else {
+            continue;
+        };
+        for s in sessions.flatten() {
+            let Ok(text) = std::fs::read_to_string(s.path().join(SOURCE_FILE)) else {
+                continue;
+            };
+            let Some(path) = text.lines().nth(1).map(PathBuf::from) else {
+                continue;
+            };
+            let file = path
+                .file_name()
+                .map(|f| f.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let selected = patterns.iter().any(|p| p.matches_path_with(&path, opts))
+                && !exclude
+                    .iter()
+                    .any(|e| e.matches(&file) || e.matches_path(&path));
+            if selected {
+                found.push(SessionRef {
+                    dataset: d.file_name().to_string_lossy().into_owned(),
+                    name: s.file_name().to_string_lossy().into_owned(),
+                    path,
+                });
+            }
+        }
+    }
+    found
+}
