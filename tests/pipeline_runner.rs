@@ -116,6 +116,43 @@ fn second_run_uses_the_cache_and_writes_identical_tables() {
 }
 
 #[test]
+fn aggregate_only_needs_no_logs() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = dir.path().join("data");
+    let sessions = fixtures(&data);
+    let out = dir.path().join("out");
+    let first = run(&out, &sessions, &[]);
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+    let a = outputs(&out);
+    for f in a.keys() {
+        std::fs::remove_file(out.join("dataset_quality").join(f)).expect("remove output");
+    }
+    // the logs go away: a plain run finds nothing, --aggregate-only uses the cache alone
+    std::fs::rename(&data, dir.path().join("moved")).expect("move the logs away");
+    assert!(!data.exists());
+    assert!(!run(&out, &sessions, &[]).status.success());
+    let again = peopletrack()
+        .arg("run")
+        .arg(pipeline())
+        .args(["--aggregate-only", "--sessions", &sessions, "--out"])
+        .arg(&out)
+        .output()
+        .expect("runs");
+    let stdout = String::from_utf8_lossy(&again.stdout);
+    assert!(
+        again.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+    assert!(stdout.contains("0 computed, 3 from cache"), "{stdout}");
+    assert_eq!(a, outputs(&out));
+}
+
+#[test]
 fn tables_do_not_depend_on_the_thread_count() {
     let dir = tempfile::tempdir().expect("tempdir");
     let sessions = fixtures(&dir.path().join("data"));
@@ -160,7 +197,16 @@ fn a_run_killed_midway_leaves_no_partial_file() {
                 Some("png") => {
                     image::load_from_memory(&bytes).unwrap_or_else(|err| panic!("{rel}: {err}"));
                 }
-                Some("txt") => assert_eq!(bytes.len(), 32, "{rel}: cache key"),
+                Some("txt") if rel.ends_with("key.txt") => {
+                    assert_eq!(bytes.len(), 32, "{rel}: cache key");
+                }
+                Some("txt") => {
+                    // source.txt: the log's hash, then its path
+                    let text = String::from_utf8(bytes).expect("utf8");
+                    let mut lines = text.lines();
+                    assert_eq!(lines.next().map(str::len), Some(32), "{rel}: log hash");
+                    assert!(lines.next().is_some_and(|l| l.ends_with(".mcap")), "{rel}");
+                }
                 _ => assert!(!bytes.is_empty(), "{rel}"),
             }
         }
