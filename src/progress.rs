@@ -1,5 +1,5 @@
 //! Progress of long steps, as the library reports it: a small trait that the binary implements
-//! with terminal progress bars (`src/cli/progress.rs`, indicatif) and tests leave silent. The
+//! with terminal progress bars (`src/cli/progress.rs`) and tests leave silent. The
 //! library never draws anything itself.
 
 use std::sync::Arc;
