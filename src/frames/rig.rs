@@ -25,7 +25,7 @@ pub enum RigError {
         file: String,
         topic: String,
         camera: String,
-        source: CameraError,
+        source: Box<CameraError>,
     },
     #[error("{file}: no transform {world} <- {frame} (camera {camera}) at {at} s: {source}")]
     NoPose {
@@ -34,7 +34,7 @@ pub enum RigError {
         frame: String,
         world: String,
         at: Nanos,
-        source: TfError,
+        source: Box<TfError>,
     },
 }
 
@@ -99,7 +99,7 @@ pub fn camera(
                 frame: frame.clone(),
                 world: world_frame.to_string(),
                 at,
-                source,
+                source: Box::new(source),
             })?;
     Ok(RigCamera {
         name: camera.to_string(),
@@ -124,7 +124,7 @@ pub fn views(
                 file: log.path().display().to_string(),
                 topic: topic.clone(),
                 camera: name.clone(),
-                source,
+                source: Box::new(source),
             })?;
             Ok(CalibratedView::new(model, cam.world_from_camera))
         })
