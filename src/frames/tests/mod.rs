@@ -2,6 +2,7 @@
 //! [`SessionWriter`].
 
 mod camera;
+mod datasets;
 mod laser;
 mod motion;
 mod multicam;
