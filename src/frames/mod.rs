@@ -49,7 +49,17 @@
 //! - Joins are nearest-stamp within a tolerance, ties to the earlier stamp, one implementation
 //!   ([`crate::log::sync::nearest`], through [`Stamped`]).
 //! - Mask pairing (s003) and multi-camera grouping (s004) are documented in [`camera`] and
-//!   [`multicam`].
+//!   [`multicam`].//!
+//! # Porting notes (where the layer differs from the loops it replaces)
+//!
+//! - s003 `for_each_frame`: a header stamp of zero now falls back to the log time (as in
+//!   s004); a mask pairs only when its width and height equal the image's (before: its pixel
+//!   count). Skip texts are unchanged. `ReadCounts` maps to `skips().count(image)`,
+//!   `skips().count(mask)`, `frames_without_mask()`, `skips().first_error()`.
+//! - s004: the raw/compressed choice is by schema name containing `CompressedImage` (same on
+//!   all standard schemas); ground truth is read by [`truth::people`] in its own pass (same
+//!   sorted result); images stay undecoded in [`MultiFrame`] so cameras decode in parallel.
+//! - s000 (which fails on the first bad message): check `skips().first_error()` and bail.
 
 pub mod camera;
 pub mod laser;
