@@ -7,6 +7,7 @@
 pub mod assign;
 pub mod calib;
 pub mod eval;
+pub mod frames;
 pub mod geometry;
 pub mod groundtruth;
 pub mod learn;
