@@ -24,24 +24,22 @@ const MAX_FN_LINES: usize = 150;
 ///
 /// 0. primitives that import nothing of ours: `time` (Nanos), `names`, `rng`, `assign`,
 ///    `progress` (the library's progress traits);
-/// 1. `geometry` (camera models, poses; no longer imports `log`);
+/// 1. `geometry` (camera models, poses; no longer imports `log`) and `groundtruth` (the JSON
+///    ground-truth contract; imports nothing, read by `frames`, `synth` and the pipelines);
 /// 2. `log` (session files; uses `time`, `geometry` for `CameraInfo` ↔ `CameraModel`);
-/// 3. `frames` (sensor frames decoded from a log);
-/// 4. `groundtruth` (the JSON ground-truth contract; imports nothing, read by `synth` and the
-///    pipelines);
-/// 5. the stages' algorithms, which may share a layer: `calib`, `learn`, `vision`, `track`;
-/// 6. `eval` (metrics and statistics: pure functions of data);
-/// 7. `synth` (writes logs through `log`; returns the preview's data, draws nothing);
-/// 8. `report` (tables, figures, the preview sheet drawn from `synth`'s data, atomic writes);
-/// 9. `run` (the runner: plan, per-session cache, aggregation, REPORT.md);
-/// 10. `pipelines` (one experiment each, on `run`);
-/// 11. `cli` (the binary: clap, progress bars; `src/main.rs` and `src/cli/`).
+/// 3. `frames` (sensor frames decoded from a log, ground truth joined);
+/// 4. the stages' algorithms, which may share a layer: `calib`, `learn`, `vision`, `track`;
+/// 5. `eval` (metrics and statistics: pure functions of data);
+/// 6. `synth` (writes logs through `log`; returns the preview's data, draws nothing);
+/// 7. `report` (tables, figures, the preview sheet drawn from `synth`'s data, atomic writes);
+/// 8. `run` (the runner: plan, per-session cache, aggregation, REPORT.md);
+/// 9. `pipelines` (one experiment each, on `run`);
+/// 10. `cli` (the binary: clap, progress bars; `src/main.rs` and `src/cli/`).
 const LAYERS: &[&[&str]] = &[
     &["time", "names", "rng", "assign", "progress"],
-    &["geometry"],
+    &["geometry", "groundtruth"],
     &["log"],
     &["frames"],
-    &["groundtruth"],
     &["calib", "learn", "vision", "track"],
     &["eval"],
     &["synth"],
