@@ -2,11 +2,11 @@
 //! sans-I/O manner: the parts that decide are functions of bytes, and [`SessionLog`] is the
 //! thin shell that opens the file and feeds them.
 //!
-//! - [`records`]: pure record parsing over `&[u8]` — opcodes, explicit bounds checks (not
+//! - `records`: pure record parsing over `&[u8]` — opcodes, explicit bounds checks (not
 //!   `binrw`), so a corrupt length gives an error but never a huge allocation or a panic;
 //!   chunk decompression and CRCs (rosbags writes 0 = not computed).
-//! - [`index`]: what opening learns — the summary section, or one linear pass without one.
-//! - [`merge`]: the time-ordered k-way merge of chunks behind [`MessageStream`]; chunks are
+//! - `index`: what opening learns — the summary section, or one linear pass without one.
+//! - `merge`: the time-ordered k-way merge of chunks behind [`MessageStream`]; chunks are
 //!   decompressed lazily and freed when consumed, equal log times keep file order.
 //! - `io`: bounded reads at an offset.
 
