@@ -28,16 +28,16 @@
 //! the Wallflower WavingTrees F-measure (real data, read from `wallflower.dir` when present,
 //! declared as an external input).
 //!
-//! Layout: `params` (parameters, validation, topics), `input` (frames, ground truth,
-//! odometry), `session` (the frame loop, which hands each [`shared::Frame`] to one state
-//! struct per sub-experiment, and the `sessions` table), one file per sub-experiment holding
+//! Layout: `params` (parameters, validation, topics), `session` (the frame loop over
+//! [`crate::frames`] camera frames joined to ground truth and odometry, which hands each
+//! [`shared::Frame`] to one state struct per sub-experiment, and the `sessions` table),
+//! `shared` (the frame, the `session` row, grouping by dataset), one file per sub-experiment holding
 //! its per-frame state, cached tables, result tables and figures (`roc`, `timing`,
 //! `components`, `colour` + `colour_report`, `local_tracks`, `wallflower`).
 
 mod colour;
 mod colour_report;
 mod components;
-mod input;
 mod local_tracks;
 mod params;
 mod roc;

@@ -9,16 +9,15 @@ use std::collections::BTreeMap;
 use image::RgbImage;
 
 use super::colour::ColourRun;
-use super::input::{
-    ReadCounts, camera_rides_robot, for_each_frame, nearest, read_ground_truth, read_motion,
-};
 use super::local_tracks::LocalRun;
-use super::params::{Params, topics_of};
+use super::params::{LocalEvalParams, Params, topics_of};
 use super::roc::RocRun;
 use super::shared::{Frame, SESSION_TABLE, SessionRow, session_row};
 use super::timing::TimingRun;
 use crate::Nanos;
+use crate::frames::{Stamped, camera, motion, truth};
 use crate::groundtruth::PeopleFrame;
+use crate::log::msgs::Odometry;
 use crate::log::tf::TfBuffer;
 use crate::progress::Progress;
 use crate::report::Table;
@@ -34,38 +33,36 @@ const ODOM_TOLERANCE_NS: u64 = 200_000_000;
 
 /// What a session has besides its frames: ground truth and camera motion.
 struct Context {
-    ground_truth: Vec<PeopleFrame>,
+    ground_truth: Stamped<PeopleFrame>,
     bad_ground_truth: i64,
-    /// `(stamp, index in ground_truth)`, sorted.
-    gt_by_stamp: Vec<(Nanos, usize)>,
-    /// `(stamp, camera moving)`, sorted; empty for a camera that does not ride the robot.
-    motion: Vec<(Nanos, bool)>,
+    /// Odometry by stamp; empty for a camera that does not ride the robot.
+    odometry: Stamped<Odometry>,
     camera_rides_robot: bool,
 }
 
 fn context(s: &Session, p: &Params, gt_topic: &str, odom_topic: &str) -> anyhow::Result<Context> {
     let log = &s.log;
-    let (ground_truth, bad_ground_truth) = read_ground_truth(log, gt_topic)?;
-    let gt_by_stamp = ground_truth
-        .iter()
-        .enumerate()
-        .map(|(i, f)| (Nanos(f.stamp_ns), i))
-        .collect();
-    let (mut motion, odom_child) = read_motion(log, odom_topic, &p.local_eval)?;
+    let (ground_truth, gt_skips) = truth::people(log, gt_topic)?;
+    let mut odom = motion::odometry(log, odom_topic)?;
     // a TF that cannot be read leaves the odometry trusted, as without TF
-    let rides = odom_child.is_empty()
-        || TfBuffer::from_log(log, 0.0)
-            .map_or(true, |tf| camera_rides_robot(&tf, &p.camera, &odom_child));
+    let rides = odom.child_frame.is_empty()
+        || TfBuffer::from_log(log, 0.0).map_or(true, |tf| {
+            motion::camera_rides_robot(&tf, &p.camera, &odom.child_frame)
+        });
     if !rides {
-        motion.clear(); // a fixed camera: never moving, whatever the robot does
+        odom.samples.clear(); // a fixed camera: never moving, whatever the robot does
     }
     Ok(Context {
         ground_truth,
-        bad_ground_truth,
-        gt_by_stamp,
-        motion,
+        bad_ground_truth: gt_skips.count(gt_topic) as i64,
+        odometry: odom.samples,
         camera_rides_robot: rides,
     })
+}
+
+/// Odometry says the robot moves: speed or turn rate above the thresholds.
+fn is_moving(o: &Odometry, p: &LocalEvalParams) -> bool {
+    o.linear.x.hypot(o.linear.y) > p.moving_speed_mps || o.angular.z.abs() > p.moving_turn_rad_s
 }
 
 /// The per-session stage: every sub-experiment's cached tables and the `session` row.
@@ -93,63 +90,61 @@ pub(super) fn process(
         p.colour.datasets.contains(&s.info.dataset) && has_mask && !cx.ground_truth.is_empty();
     let mut colour = ColourRun::new(p, colour_wanted);
     let mut local = LocalRun::new(p)?;
-    let mut counts = ReadCounts::default();
     let mut first_stamp: Option<Nanos> = None;
     let mut frame_index: i64 = -1;
     let mut shape = (0u32, 0u32);
     let mut last_rgb: Option<RgbImage> = None;
 
-    for_each_frame(
-        log,
-        &tp.image,
-        has_mask.then_some(tp.mask.as_str()),
-        &mut counts,
-        |f| {
-            frame_index += 1;
-            bar.inc(1);
-            let t0 = *first_stamp.get_or_insert(f.stamp);
-            let (w, h) = (f.rgb.width(), f.rgb.height());
-            if frame_index == 0 {
-                shape = (w, h);
-            } else if shape != (w, h) {
-                anyhow::bail!(
-                    "{}: {} at {} ns: frame is {w}x{h}, earlier frames were {}x{}",
-                    log.path().display(),
-                    tp.image,
-                    f.stamp.0,
-                    shape.0,
-                    shape.1
-                );
-            }
-            let frame = Frame {
-                index: frame_index,
-                t_s: f.stamp.0.saturating_sub(t0.0) as f64 * 1e-9,
-                rgb: &f.rgb,
-                view: ImageView::rgb(&f.rgb)?,
-                mask: f.mask.as_deref(),
-                truth: nearest(&cx.gt_by_stamp, f.stamp, GT_TOLERANCE_NS)
-                    .map(|&i| &cx.ground_truth[i]),
-                moving: nearest(&cx.motion, f.stamp, ODOM_TOLERANCE_NS)
-                    .copied()
-                    .unwrap_or(false),
-            };
-            roc.step(&frame)?;
-            if let Some(t) = timing.as_mut() {
-                t.step(&frame)?;
-            }
-            colour.step(&frame)?;
-            local.step(&frame)?;
-            last_rgb = Some(f.rgb);
-            Ok(())
-        },
-    )?;
+    let mask_topic = has_mask.then_some(tp.mask.as_str());
+    let mut frames = camera::frames(log, &tp.image, mask_topic)?;
+    for f in &mut frames {
+        let f = f?;
+        frame_index += 1;
+        bar.inc(1);
+        let t0 = *first_stamp.get_or_insert(f.stamp);
+        let (w, h) = (f.rgb.width(), f.rgb.height());
+        if frame_index == 0 {
+            shape = (w, h);
+        } else if shape != (w, h) {
+            anyhow::bail!(
+                "{}: {} at {} ns: frame is {w}x{h}, earlier frames were {}x{}",
+                log.path().display(),
+                tp.image,
+                f.stamp.0,
+                shape.0,
+                shape.1
+            );
+        }
+        let frame = Frame {
+            index: frame_index,
+            t_s: f.stamp.0.saturating_sub(t0.0) as f64 * 1e-9,
+            rgb: &f.rgb,
+            view: ImageView::rgb(&f.rgb)?,
+            mask: f.mask.as_ref().map(|m| m.as_raw().as_slice()),
+            truth: cx.ground_truth.nearest(f.stamp, GT_TOLERANCE_NS),
+            moving: cx
+                .odometry
+                .nearest(f.stamp, ODOM_TOLERANCE_NS)
+                .is_some_and(|o| is_moving(o, &p.local_eval)),
+        };
+        roc.step(&frame)?;
+        if let Some(t) = timing.as_mut() {
+            t.step(&frame)?;
+        }
+        colour.step(&frame)?;
+        local.step(&frame)?;
+        last_rgb = Some(f.rgb);
+    }
+    let frames_without_mask = frames.frames_without_mask() as i64;
+    let skips = frames.into_skips();
+    let bad_images = skips.count(&tp.image) as i64;
+    let first_error = skips.first_error().unwrap_or_default().to_string();
     if frame_index < 0 {
         anyhow::bail!(
-            "{}: no decodable frame on {} ({} bad images; first error: {})",
+            "{}: no decodable frame on {} ({bad_images} bad images; first error: {})",
             log.path().display(),
             tp.image,
-            counts.bad_images,
-            counts.first_error.as_deref().unwrap_or("none")
+            skips.first_error().unwrap_or("none")
         );
     }
 
@@ -161,11 +156,11 @@ pub(super) fn process(
         width: i64::from(shape.0),
         height: i64::from(shape.1),
         has_mask,
-        bad_images: counts.bad_images,
-        bad_masks: counts.bad_masks,
-        frames_without_mask: counts.frames_without_mask,
+        bad_images,
+        bad_masks: mask_topic.map_or(0, |m| skips.count(m) as i64),
+        frames_without_mask,
         bad_ground_truth: cx.bad_ground_truth,
-        first_error: counts.first_error.clone().unwrap_or_default(),
+        first_error,
         camera_rides_robot: cx.camera_rides_robot,
         colour_frame0: colour.frame0(),
         ..Default::default()
