@@ -87,147 +87,12 @@ impl Shape {
                 }
                 Hit { t, normal }
             }
-            Shape::Box { center, half, yaw } => {
-                let (s, c) = yaw.sin_cos();
-                // into the box frame (rotate by −yaw)
-                let rel = o - center;
-                let lo = Vector3::new(c * rel.x + s * rel.y, -s * rel.x + c * rel.y, rel.z);
-                let ld = Vector3::new(c * d.x + s * d.y, -s * d.x + c * d.y, d.z);
-                let (mut t0, mut t1) = (f64::NEG_INFINITY, f64::INFINITY);
-                let (mut axis0, mut sign0) = (0usize, 1.0f64);
-                for k in 0..3 {
-                    if ld[k].abs() < 1e-15 {
-                        if lo[k].abs() > half[k] {
-                            return None;
-                        }
-                        continue;
-                    }
-                    let inv = 1.0 / ld[k];
-                    let (mut a, mut b) = ((-half[k] - lo[k]) * inv, (half[k] - lo[k]) * inv);
-                    let mut sg = -1.0;
-                    if a > b {
-                        std::mem::swap(&mut a, &mut b);
-                        sg = 1.0;
-                    }
-                    if a > t0 {
-                        t0 = a;
-                        axis0 = k;
-                        sign0 = sg;
-                    }
-                    t1 = t1.min(b);
-                    if t0 > t1 {
-                        return None;
-                    }
-                }
-                if t0 <= t_min {
-                    return None; // inside the box, or behind: boxes are solid, seen from outside
-                }
-                let mut ln = Vector3::zeros();
-                ln[axis0] = sign0;
-                Hit {
-                    t: t0,
-                    normal: Vector3::new(c * ln.x - s * ln.y, s * ln.x + c * ln.y, ln.z),
-                }
-            }
+            Shape::Box { center, half, yaw } => hit_box(o, d, t_min, center, half, *yaw)?,
             Shape::Cylinder { x, y, z0, z1, r } => {
-                let (ox, oy) = (o.x - x, o.y - y);
-                let a = d.x * d.x + d.y * d.y;
-                let mut best: Option<Hit> = None;
-                if a > 1e-15 {
-                    let b = ox * d.x + oy * d.y;
-                    let c = ox * ox + oy * oy - r * r;
-                    let disc = b * b - a * c;
-                    if disc >= 0.0 {
-                        let t = (-b - disc.sqrt()) / a;
-                        let z = o.z + t * d.z;
-                        if t > t_min && z >= *z0 && z <= *z1 {
-                            best = Some(Hit {
-                                t,
-                                normal: Vector3::new((ox + t * d.x) / r, (oy + t * d.y) / r, 0.0),
-                            });
-                        }
-                    }
-                }
-                for (zc, n) in [(*z1, 1.0), (*z0, -1.0)] {
-                    if d.z.abs() < 1e-15 {
-                        continue;
-                    }
-                    let t = (zc - o.z) / d.z;
-                    if t > t_min && best.is_none_or(|h| t < h.t) && n * d.z < 0.0 {
-                        let (px, py) = (ox + t * d.x, oy + t * d.y);
-                        if px * px + py * py <= r * r {
-                            best = Some(Hit {
-                                t,
-                                normal: Vector3::new(0.0, 0.0, n),
-                            });
-                        }
-                    }
-                }
-                best?
+                hit_cylinder(o, d, t_min, (*x, *y), (*z0, *z1), *r)?
             }
-            Shape::Capsule { a, b, r } => {
-                // Inigo Quilez's capsule intersection
-                let ba = b - a;
-                let oa = o - a;
-                let baba = ba.dot(&ba);
-                let bard = ba.dot(d);
-                let baoa = ba.dot(&oa);
-                let rdoa = d.dot(&oa);
-                let oaoa = oa.dot(&oa);
-                let qa = baba - bard * bard;
-                let qb = baba * rdoa - baoa * bard;
-                let qc = baba * oaoa - baoa * baoa - r * r * baba;
-                let h = qb * qb - qa * qc;
-                if h < 0.0 {
-                    return None;
-                }
-                let sphere = |c: &Point3<f64>| {
-                    let oc = o - c;
-                    let bq = d.dot(&oc);
-                    let hq = bq * bq - (oc.dot(&oc) - r * r);
-                    (hq >= 0.0).then(|| -bq - hq.sqrt()).filter(|t| *t > t_min)
-                };
-                let body = (qa.abs() > 1e-15)
-                    .then(|| (-qb - h.sqrt()) / qa)
-                    .filter(|t| {
-                        let y = baoa + t * bard;
-                        y > 0.0 && y < baba
-                    });
-                let t = match body {
-                    Some(t) => t,
-                    // parallel to the axis, or the body hit lies beyond an end: nearest cap
-                    None => match (sphere(a), sphere(b)) {
-                        (Some(x), Some(y)) => x.min(y),
-                        (Some(x), None) | (None, Some(x)) => x,
-                        (None, None) => return None,
-                    },
-                };
-                let p = o + d * t;
-                let pa = p - a;
-                let k = (pa.dot(&ba) / baba).clamp(0.0, 1.0);
-                let normal = (pa - ba * k) / *r;
-                Hit { t, normal }
-            }
-            Shape::Ellipsoid { center, radii, yaw } => {
-                let (s, c) = yaw.sin_cos();
-                let rel = o - center;
-                let lo = Vector3::new(c * rel.x + s * rel.y, -s * rel.x + c * rel.y, rel.z)
-                    .component_div(radii);
-                let ld =
-                    Vector3::new(c * d.x + s * d.y, -s * d.x + c * d.y, d.z).component_div(radii);
-                let a = ld.dot(&ld);
-                let b = lo.dot(&ld);
-                let cc = lo.dot(&lo) - 1.0;
-                let disc = b * b - a * cc;
-                if disc < 0.0 {
-                    return None;
-                }
-                let t = (-b - disc.sqrt()) / a;
-                let lp = lo + ld * t;
-                let ln = lp.component_div(radii); // gradient in the turned frame
-                let n = Vector3::new(c * ln.x - s * ln.y, s * ln.x + c * ln.y, ln.z).normalize();
-                Hit { t, normal: n }
-            }
+            Shape::Capsule { a, b, r } => hit_capsule(o, d, t_min, a, b, *r)?,
+            Shape::Ellipsoid { center, radii, yaw } => hit_ellipsoid(o, d, center, radii, *yaw)?,
             Shape::Rect { center, u, v } => {
                 let n = u.cross(v);
                 let denom = n.dot(d);
@@ -292,6 +157,181 @@ impl Shape {
             },
         }
     }
+}
+
+/// Ray–box hit, in the box's turned frame (slab test); `None` from inside or behind.
+fn hit_box(
+    o: &Point3<f64>,
+    d: &Vector3<f64>,
+    t_min: f64,
+    center: &Point3<f64>,
+    half: &Vector3<f64>,
+    yaw: f64,
+) -> Option<Hit> {
+    let (s, c) = yaw.sin_cos();
+    // into the box frame (rotate by −yaw)
+    let rel = o - center;
+    let lo = Vector3::new(c * rel.x + s * rel.y, -s * rel.x + c * rel.y, rel.z);
+    let ld = Vector3::new(c * d.x + s * d.y, -s * d.x + c * d.y, d.z);
+    let (mut t0, mut t1) = (f64::NEG_INFINITY, f64::INFINITY);
+    let (mut axis0, mut sign0) = (0usize, 1.0f64);
+    for k in 0..3 {
+        if ld[k].abs() < 1e-15 {
+            if lo[k].abs() > half[k] {
+                return None;
+            }
+            continue;
+        }
+        let inv = 1.0 / ld[k];
+        let (mut a, mut b) = ((-half[k] - lo[k]) * inv, (half[k] - lo[k]) * inv);
+        let mut sg = -1.0;
+        if a > b {
+            std::mem::swap(&mut a, &mut b);
+            sg = 1.0;
+        }
+        if a > t0 {
+            t0 = a;
+            axis0 = k;
+            sign0 = sg;
+        }
+        t1 = t1.min(b);
+        if t0 > t1 {
+            return None;
+        }
+    }
+    if t0 <= t_min {
+        return None; // inside the box, or behind: boxes are solid, seen from outside
+    }
+    let mut ln = Vector3::zeros();
+    ln[axis0] = sign0;
+    Some(Hit {
+        t: t0,
+        normal: Vector3::new(c * ln.x - s * ln.y, s * ln.x + c * ln.y, ln.z),
+    })
+}
+
+/// Ray–vertical-cylinder hit: the side, then the caps.
+fn hit_cylinder(
+    o: &Point3<f64>,
+    d: &Vector3<f64>,
+    t_min: f64,
+    (x, y): (f64, f64),
+    (z0, z1): (f64, f64),
+    r: f64,
+) -> Option<Hit> {
+    let (ox, oy) = (o.x - x, o.y - y);
+    let a = d.x * d.x + d.y * d.y;
+    let mut best: Option<Hit> = None;
+    if a > 1e-15 {
+        let b = ox * d.x + oy * d.y;
+        let c = ox * ox + oy * oy - r * r;
+        let disc = b * b - a * c;
+        if disc >= 0.0 {
+            let t = (-b - disc.sqrt()) / a;
+            let z = o.z + t * d.z;
+            if t > t_min && z >= z0 && z <= z1 {
+                best = Some(Hit {
+                    t,
+                    normal: Vector3::new((ox + t * d.x) / r, (oy + t * d.y) / r, 0.0),
+                });
+            }
+        }
+    }
+    for (zc, n) in [(z1, 1.0), (z0, -1.0)] {
+        if d.z.abs() < 1e-15 {
+            continue;
+        }
+        let t = (zc - o.z) / d.z;
+        if t > t_min && best.is_none_or(|h| t < h.t) && n * d.z < 0.0 {
+            let (px, py) = (ox + t * d.x, oy + t * d.y);
+            if px * px + py * py <= r * r {
+                best = Some(Hit {
+                    t,
+                    normal: Vector3::new(0.0, 0.0, n),
+                });
+            }
+        }
+    }
+    best
+}
+
+/// Ray–capsule hit (Inigo Quilez's capsule intersection).
+fn hit_capsule(
+    o: &Point3<f64>,
+    d: &Vector3<f64>,
+    t_min: f64,
+    a: &Point3<f64>,
+    b: &Point3<f64>,
+    r: f64,
+) -> Option<Hit> {
+    // Inigo Quilez's capsule intersection
+    let ba = b - a;
+    let oa = o - a;
+    let baba = ba.dot(&ba);
+    let bard = ba.dot(d);
+    let baoa = ba.dot(&oa);
+    let rdoa = d.dot(&oa);
+    let oaoa = oa.dot(&oa);
+    let qa = baba - bard * bard;
+    let qb = baba * rdoa - baoa * bard;
+    let qc = baba * oaoa - baoa * baoa - r * r * baba;
+    let h = qb * qb - qa * qc;
+    if h < 0.0 {
+        return None;
+    }
+    let sphere = |c: &Point3<f64>| {
+        let oc = o - c;
+        let bq = d.dot(&oc);
+        let hq = bq * bq - (oc.dot(&oc) - r * r);
+        (hq >= 0.0).then(|| -bq - hq.sqrt()).filter(|t| *t > t_min)
+    };
+    let body = (qa.abs() > 1e-15)
+        .then(|| (-qb - h.sqrt()) / qa)
+        .filter(|t| {
+            let y = baoa + t * bard;
+            y > 0.0 && y < baba
+        });
+    let t = match body {
+        Some(t) => t,
+        // parallel to the axis, or the body hit lies beyond an end: nearest cap
+        None => match (sphere(a), sphere(b)) {
+            (Some(x), Some(y)) => x.min(y),
+            (Some(x), None) | (None, Some(x)) => x,
+            (None, None) => return None,
+        },
+    };
+    let p = o + d * t;
+    let pa = p - a;
+    let k = (pa.dot(&ba) / baba).clamp(0.0, 1.0);
+    let normal = (pa - ba * k) / r;
+    Some(Hit { t, normal })
+}
+
+/// Ray–ellipsoid hit, in the ellipsoid's turned and scaled frame.
+fn hit_ellipsoid(
+    o: &Point3<f64>,
+    d: &Vector3<f64>,
+    center: &Point3<f64>,
+    radii: &Vector3<f64>,
+    yaw: f64,
+) -> Option<Hit> {
+    let (s, c) = yaw.sin_cos();
+    let rel = o - center;
+    let lo =
+        Vector3::new(c * rel.x + s * rel.y, -s * rel.x + c * rel.y, rel.z).component_div(radii);
+    let ld = Vector3::new(c * d.x + s * d.y, -s * d.x + c * d.y, d.z).component_div(radii);
+    let a = ld.dot(&ld);
+    let b = lo.dot(&ld);
+    let cc = lo.dot(&lo) - 1.0;
+    let disc = b * b - a * cc;
+    if disc < 0.0 {
+        return None;
+    }
+    let t = (-b - disc.sqrt()) / a;
+    let lp = lo + ld * t;
+    let ln = lp.component_div(radii); // gradient in the turned frame
+    let n = Vector3::new(c * ln.x - s * ln.y, s * ln.x + c * ln.y, ln.z).normalize();
+    Some(Hit { t, normal: n })
 }
 
 #[cfg(test)]

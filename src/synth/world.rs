@@ -6,7 +6,9 @@
 use nalgebra::{Point3, Vector3};
 use rand::RngExt;
 
-use super::scenario::{DynamicSpec, Light, Rgb, Scenario, TextureSpec, WorldKind};
+use super::scenario::{
+    DynamicSpec, Light, Rgb, Scatter, Scenario, TextureSpec, World as WorldSpec, WorldKind,
+};
 use super::shapes::Shape;
 use crate::rng;
 
@@ -314,10 +316,323 @@ pub fn sky(dir: &Vector3<f64>) -> [f32; 3] {
     [0.55 - 0.25 * e, 0.68 - 0.2 * e, 0.9 - 0.05 * e]
 }
 
+/// Ceiling, the four walls and the doors of a room, after the floor.
+fn push_room(w: &WorldSpec, statics: &mut Vec<Primitive>) {
+    let (sx, sy, h) = (w.size[0], w.size[1], w.wall_height);
+    let wall = w
+        .walls
+        .clone()
+        .map_or(Material::flat([200, 200, 195]), |s| {
+            Material::textured(s.color, s.texture)
+        });
+    statics.push(Primitive::new(
+        Shape::Plane { z: h, up: false },
+        Material::flat([235, 235, 230]),
+        0,
+    ));
+    let t = 0.1;
+    for (center, half) in [
+        (
+            Point3::new(-t, sy / 2.0, h / 2.0),
+            Vector3::new(t, sy / 2.0 + 2.0 * t, h / 2.0),
+        ),
+        (
+            Point3::new(sx + t, sy / 2.0, h / 2.0),
+            Vector3::new(t, sy / 2.0 + 2.0 * t, h / 2.0),
+        ),
+        (
+            Point3::new(sx / 2.0, -t, h / 2.0),
+            Vector3::new(sx / 2.0 + 2.0 * t, t, h / 2.0),
+        ),
+        (
+            Point3::new(sx / 2.0, sy + t, h / 2.0),
+            Vector3::new(sx / 2.0 + 2.0 * t, t, h / 2.0),
+        ),
+    ] {
+        statics.push(Primitive::new(
+            Shape::Box {
+                center,
+                half,
+                yaw: 0.0,
+            },
+            wall,
+            0,
+        ));
+    }
+    // doors: dark rectangles on the nearest wall, facing into the room
+    for d in &w.doors {
+        let [x, y] = d.at;
+        let hw = d.width / 2.0;
+        let dist = [x, sx - x, y, sy - y];
+        let k = (0..4)
+            .min_by(|a, b| dist[*a].total_cmp(&dist[*b]))
+            .unwrap_or(0);
+        let (center, u) = match k {
+            0 => (Point3::new(0.005, y, 1.0), Vector3::new(0.0, -hw, 0.0)),
+            1 => (Point3::new(sx - 0.005, y, 1.0), Vector3::new(0.0, hw, 0.0)),
+            2 => (Point3::new(x, 0.005, 1.0), Vector3::new(hw, 0.0, 0.0)),
+            _ => (Point3::new(x, sy - 0.005, 1.0), Vector3::new(-hw, 0.0, 0.0)),
+        };
+        // one-sided rect faces u × v; v is up
+        statics.push(Primitive::new(
+            Shape::Rect {
+                center,
+                u,
+                v: Vector3::new(0.0, 0.0, 1.0),
+            },
+            Material::textured(
+                [96, 70, 52],
+                TextureSpec::Noise {
+                    scale: 0.2,
+                    amp: 0.15,
+                },
+            ),
+            0,
+        ));
+    }
+}
+
+/// Boxes (desks, cabinets), with legs when raised and as obstacles when not.
+fn push_boxes(w: &WorldSpec, statics: &mut Vec<Primitive>, obstacles: &mut Vec<Obstacle>) {
+    for b in &w.boxes {
+        let half = Vector3::new(b.size[0] / 2.0, b.size[1] / 2.0, b.size[2] / 2.0);
+        let center = Point3::new(b.at[0], b.at[1], b.raised + half.z);
+        statics.push(Primitive::new(
+            Shape::Box {
+                center,
+                half,
+                yaw: b.yaw_deg.to_radians(),
+            },
+            Material::textured(b.color, b.texture),
+            0,
+        ));
+        if b.raised > 0.0 {
+            // four thin legs, so a laser below the top sees them
+            let (s, c) = b.yaw_deg.to_radians().sin_cos();
+            for (ex, ey) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
+                let (lx, ly) = (ex * (half.x - 0.05), ey * (half.y - 0.05));
+                statics.push(Primitive::new(
+                    Shape::Cylinder {
+                        x: b.at[0] + c * lx - s * ly,
+                        y: b.at[1] + s * lx + c * ly,
+                        z0: 0.0,
+                        z1: b.raised,
+                        r: 0.02,
+                    },
+                    Material::flat([90, 90, 95]),
+                    0,
+                ));
+            }
+        } else {
+            obstacles.push(Obstacle {
+                x: b.at[0],
+                y: b.at[1],
+                hx: half.x,
+                hy: half.y,
+                yaw: b.yaw_deg.to_radians(),
+                round: false,
+            });
+        }
+    }
+}
+
+/// Trees and bushes scattered at random, clear of the keep-clear discs and of each other.
+fn push_scatter(
+    sc: &Scatter,
+    size: [f64; 2],
+    mut r: rand_chacha::ChaCha8Rng,
+    statics: &mut Vec<Primitive>,
+    obstacles: &mut Vec<Obstacle>,
+) {
+    let (sx, sy) = (size[0], size[1]);
+    let clear = |x: f64, y: f64, obstacles: &[Obstacle]| {
+        sc.keep_clear
+            .iter()
+            .all(|[cx, cy, cr]| (x - cx).hypot(y - cy) > *cr)
+            && obstacles.iter().all(|o| o.distance(x, y) > 2.0)
+    };
+    let place = |n: u32, r: &mut rand_chacha::ChaCha8Rng, obstacles: &mut Vec<Obstacle>| {
+        let mut out = Vec::new();
+        let mut tries = 0;
+        while out.len() < n as usize && tries < 10_000 {
+            tries += 1;
+            let (x, y) = (r.random::<f64>() * sx, r.random::<f64>() * sy);
+            if clear(x, y, obstacles) {
+                out.push((x, y));
+                obstacles.push(Obstacle::disc(x, y, 0.5));
+            }
+        }
+        out
+    };
+    for (x, y) in place(sc.trees, &mut r, obstacles) {
+        let trunk = 0.12 + 0.15 * r.random::<f64>();
+        let crown_z = 2.2 + 1.5 * r.random::<f64>();
+        let crown_r = 1.2 + 1.2 * r.random::<f64>();
+        statics.push(Primitive::new(
+            Shape::Cylinder {
+                x,
+                y,
+                z0: 0.0,
+                z1: crown_z + 0.5,
+                r: trunk,
+            },
+            Material::textured(
+                [92, 70, 50],
+                TextureSpec::Noise {
+                    scale: 0.15,
+                    amp: 0.25,
+                },
+            ),
+            0,
+        ));
+        statics.push(Primitive::new(
+            Shape::Ellipsoid {
+                center: Point3::new(x, y, crown_z + crown_r * 0.8),
+                radii: Vector3::new(crown_r, crown_r, crown_r * 0.9),
+                yaw: 0.0,
+            },
+            Material::textured(
+                [60, 110, 45],
+                TextureSpec::Noise {
+                    scale: 0.4,
+                    amp: 0.35,
+                },
+            ),
+            0,
+        ));
+        if let Some(o) = obstacles.last_mut() {
+            *o = Obstacle::disc(x, y, trunk);
+        }
+    }
+    for (x, y) in place(sc.bushes, &mut r, obstacles) {
+        let br = 0.3 + 0.5 * r.random::<f64>();
+        statics.push(Primitive::new(
+            Shape::Ellipsoid {
+                center: Point3::new(x, y, br * 0.7),
+                radii: Vector3::new(br, br * (0.7 + 0.5 * r.random::<f64>()), br * 0.8),
+                yaw: r.random::<f64>() * std::f64::consts::PI,
+            },
+            Material::textured(
+                [70, 120, 55],
+                TextureSpec::Noise {
+                    scale: 0.2,
+                    amp: 0.35,
+                },
+            ),
+            0,
+        ));
+        if let Some(o) = obstacles.last_mut() {
+            *o = Obstacle::disc(x, y, br);
+        }
+    }
+}
+
+/// The moving background, with the static parts (monitor bezels, plant pots) it needs.
+fn moving_background(s: &Scenario, session: u64, statics: &mut Vec<Primitive>) -> Vec<Moving> {
+    let mut moving = Vec::new();
+    for d in &s.world.dynamic {
+        match d {
+            DynamicSpec::Monitor {
+                at,
+                size,
+                yaw_deg,
+                color,
+                bar_period_s,
+            } => {
+                let (s_, c) = yaw_deg.to_radians().sin_cos();
+                // facing direction is the yaw; u runs to the right of the screen
+                let facing = Vector3::new(c, s_, 0.0);
+                let u = Vector3::new(s_, -c, 0.0) * (size[0] / 2.0);
+                let v = Vector3::new(0.0, 0.0, size[1] / 2.0);
+                let (u, v) = if u.cross(&v).dot(&facing) > 0.0 {
+                    (u, v)
+                } else {
+                    (-u, v)
+                };
+                let center = Point3::from(*at);
+                statics.push(Primitive::new(
+                    Shape::Box {
+                        center: center - facing * 0.06,
+                        half: Vector3::new(0.05, size[0] / 2.0 + 0.03, size[1] / 2.0 + 0.03),
+                        yaw: yaw_deg.to_radians(),
+                    },
+                    Material::flat([30, 30, 32]),
+                    0,
+                ));
+                moving.push(Moving::Monitor {
+                    rect: Shape::Rect {
+                        center: center + facing * 0.001,
+                        u,
+                        v,
+                    },
+                    color: *color,
+                    period_s: *bar_period_s,
+                });
+            }
+            DynamicSpec::Plant {
+                at,
+                height,
+                radius,
+                color,
+                sway_m,
+                period_s,
+            } => {
+                statics.push(Primitive::new(
+                    Shape::Cylinder {
+                        x: at[0],
+                        y: at[1],
+                        z0: 0.0,
+                        z1: 0.35,
+                        r: radius * 0.5,
+                    },
+                    Material::flat([150, 80, 50]),
+                    0,
+                ));
+                moving.push(Moving::Plant {
+                    base: *at,
+                    height: *height,
+                    radius: *radius,
+                    color: *color,
+                    sway_m: *sway_m,
+                    period_s: *period_s,
+                });
+            }
+            DynamicSpec::Traffic {
+                y,
+                x_range,
+                speed,
+                every_s,
+                size,
+            } => {
+                let mut r = rng::stream(s.scenario.seed, "traffic", session);
+                let palette: [Rgb; 6] = [
+                    [180, 30, 30],
+                    [30, 60, 160],
+                    [220, 220, 220],
+                    [40, 40, 40],
+                    [200, 160, 40],
+                    [90, 140, 90],
+                ];
+                let colors = (0..64)
+                    .map(|_| palette[r.random_range(0..palette.len())])
+                    .collect();
+                moving.push(Moving::Traffic {
+                    y: *y,
+                    x_range: *x_range,
+                    speed: *speed,
+                    every_s: *every_s,
+                    size: *size,
+                    colors,
+                });
+            }
+        }
+    }
+    moving
+}
+
 impl World {
     pub fn build(s: &Scenario, session: u64) -> World {
         let w = &s.world;
-        let (sx, sy, h) = (w.size[0], w.size[1], w.wall_height);
         let mut statics = Vec::new();
         let mut obstacles = Vec::new();
         statics.push(Primitive::new(
@@ -326,299 +641,14 @@ impl World {
             0,
         ));
         if w.kind == WorldKind::Room {
-            let wall = w
-                .walls
-                .clone()
-                .map_or(Material::flat([200, 200, 195]), |s| {
-                    Material::textured(s.color, s.texture)
-                });
-            statics.push(Primitive::new(
-                Shape::Plane { z: h, up: false },
-                Material::flat([235, 235, 230]),
-                0,
-            ));
-            let t = 0.1;
-            for (center, half) in [
-                (
-                    Point3::new(-t, sy / 2.0, h / 2.0),
-                    Vector3::new(t, sy / 2.0 + 2.0 * t, h / 2.0),
-                ),
-                (
-                    Point3::new(sx + t, sy / 2.0, h / 2.0),
-                    Vector3::new(t, sy / 2.0 + 2.0 * t, h / 2.0),
-                ),
-                (
-                    Point3::new(sx / 2.0, -t, h / 2.0),
-                    Vector3::new(sx / 2.0 + 2.0 * t, t, h / 2.0),
-                ),
-                (
-                    Point3::new(sx / 2.0, sy + t, h / 2.0),
-                    Vector3::new(sx / 2.0 + 2.0 * t, t, h / 2.0),
-                ),
-            ] {
-                statics.push(Primitive::new(
-                    Shape::Box {
-                        center,
-                        half,
-                        yaw: 0.0,
-                    },
-                    wall,
-                    0,
-                ));
-            }
-            // doors: dark rectangles on the nearest wall, facing into the room
-            for d in &w.doors {
-                let [x, y] = d.at;
-                let hw = d.width / 2.0;
-                let dist = [x, sx - x, y, sy - y];
-                let k = (0..4)
-                    .min_by(|a, b| dist[*a].total_cmp(&dist[*b]))
-                    .unwrap_or(0);
-                let (center, u) = match k {
-                    0 => (Point3::new(0.005, y, 1.0), Vector3::new(0.0, -hw, 0.0)),
-                    1 => (Point3::new(sx - 0.005, y, 1.0), Vector3::new(0.0, hw, 0.0)),
-                    2 => (Point3::new(x, 0.005, 1.0), Vector3::new(hw, 0.0, 0.0)),
-                    _ => (Point3::new(x, sy - 0.005, 1.0), Vector3::new(-hw, 0.0, 0.0)),
-                };
-                // one-sided rect faces u × v; v is up
-                statics.push(Primitive::new(
-                    Shape::Rect {
-                        center,
-                        u,
-                        v: Vector3::new(0.0, 0.0, 1.0),
-                    },
-                    Material::textured(
-                        [96, 70, 52],
-                        TextureSpec::Noise {
-                            scale: 0.2,
-                            amp: 0.15,
-                        },
-                    ),
-                    0,
-                ));
-            }
+            push_room(w, &mut statics);
         }
-        for b in &w.boxes {
-            let half = Vector3::new(b.size[0] / 2.0, b.size[1] / 2.0, b.size[2] / 2.0);
-            let center = Point3::new(b.at[0], b.at[1], b.raised + half.z);
-            statics.push(Primitive::new(
-                Shape::Box {
-                    center,
-                    half,
-                    yaw: b.yaw_deg.to_radians(),
-                },
-                Material::textured(b.color, b.texture),
-                0,
-            ));
-            if b.raised > 0.0 {
-                // four thin legs, so a laser below the top sees them
-                let (s, c) = b.yaw_deg.to_radians().sin_cos();
-                for (ex, ey) in [(1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0)] {
-                    let (lx, ly) = (ex * (half.x - 0.05), ey * (half.y - 0.05));
-                    statics.push(Primitive::new(
-                        Shape::Cylinder {
-                            x: b.at[0] + c * lx - s * ly,
-                            y: b.at[1] + s * lx + c * ly,
-                            z0: 0.0,
-                            z1: b.raised,
-                            r: 0.02,
-                        },
-                        Material::flat([90, 90, 95]),
-                        0,
-                    ));
-                }
-            } else {
-                obstacles.push(Obstacle {
-                    x: b.at[0],
-                    y: b.at[1],
-                    hx: half.x,
-                    hy: half.y,
-                    yaw: b.yaw_deg.to_radians(),
-                    round: false,
-                });
-            }
-        }
+        push_boxes(w, &mut statics, &mut obstacles);
         if let Some(sc) = &w.scatter {
-            let mut r = rng::stream(s.scenario.seed, "scatter", session);
-            let clear = |x: f64, y: f64, obstacles: &[Obstacle]| {
-                sc.keep_clear
-                    .iter()
-                    .all(|[cx, cy, cr]| (x - cx).hypot(y - cy) > *cr)
-                    && obstacles.iter().all(|o| o.distance(x, y) > 2.0)
-            };
-            let place = |n: u32, r: &mut rand_chacha::ChaCha8Rng, obstacles: &mut Vec<Obstacle>| {
-                let mut out = Vec::new();
-                let mut tries = 0;
-                while out.len() < n as usize && tries < 10_000 {
-                    tries += 1;
-                    let (x, y) = (r.random::<f64>() * sx, r.random::<f64>() * sy);
-                    if clear(x, y, obstacles) {
-                        out.push((x, y));
-                        obstacles.push(Obstacle::disc(x, y, 0.5));
-                    }
-                }
-                out
-            };
-            for (x, y) in place(sc.trees, &mut r, &mut obstacles) {
-                let trunk = 0.12 + 0.15 * r.random::<f64>();
-                let crown_z = 2.2 + 1.5 * r.random::<f64>();
-                let crown_r = 1.2 + 1.2 * r.random::<f64>();
-                statics.push(Primitive::new(
-                    Shape::Cylinder {
-                        x,
-                        y,
-                        z0: 0.0,
-                        z1: crown_z + 0.5,
-                        r: trunk,
-                    },
-                    Material::textured(
-                        [92, 70, 50],
-                        TextureSpec::Noise {
-                            scale: 0.15,
-                            amp: 0.25,
-                        },
-                    ),
-                    0,
-                ));
-                statics.push(Primitive::new(
-                    Shape::Ellipsoid {
-                        center: Point3::new(x, y, crown_z + crown_r * 0.8),
-                        radii: Vector3::new(crown_r, crown_r, crown_r * 0.9),
-                        yaw: 0.0,
-                    },
-                    Material::textured(
-                        [60, 110, 45],
-                        TextureSpec::Noise {
-                            scale: 0.4,
-                            amp: 0.35,
-                        },
-                    ),
-                    0,
-                ));
-                if let Some(o) = obstacles.last_mut() {
-                    *o = Obstacle::disc(x, y, trunk);
-                }
-            }
-            for (x, y) in place(sc.bushes, &mut r, &mut obstacles) {
-                let br = 0.3 + 0.5 * r.random::<f64>();
-                statics.push(Primitive::new(
-                    Shape::Ellipsoid {
-                        center: Point3::new(x, y, br * 0.7),
-                        radii: Vector3::new(br, br * (0.7 + 0.5 * r.random::<f64>()), br * 0.8),
-                        yaw: r.random::<f64>() * std::f64::consts::PI,
-                    },
-                    Material::textured(
-                        [70, 120, 55],
-                        TextureSpec::Noise {
-                            scale: 0.2,
-                            amp: 0.35,
-                        },
-                    ),
-                    0,
-                ));
-                if let Some(o) = obstacles.last_mut() {
-                    *o = Obstacle::disc(x, y, br);
-                }
-            }
+            let r = rng::stream(s.scenario.seed, "scatter", session);
+            push_scatter(sc, w.size, r, &mut statics, &mut obstacles);
         }
-        let mut moving = Vec::new();
-        for d in &w.dynamic {
-            match d {
-                DynamicSpec::Monitor {
-                    at,
-                    size,
-                    yaw_deg,
-                    color,
-                    bar_period_s,
-                } => {
-                    let (s_, c) = yaw_deg.to_radians().sin_cos();
-                    // facing direction is the yaw; u runs to the right of the screen
-                    let facing = Vector3::new(c, s_, 0.0);
-                    let u = Vector3::new(s_, -c, 0.0) * (size[0] / 2.0);
-                    let v = Vector3::new(0.0, 0.0, size[1] / 2.0);
-                    let (u, v) = if u.cross(&v).dot(&facing) > 0.0 {
-                        (u, v)
-                    } else {
-                        (-u, v)
-                    };
-                    let center = Point3::from(*at);
-                    statics.push(Primitive::new(
-                        Shape::Box {
-                            center: center - facing * 0.06,
-                            half: Vector3::new(0.05, size[0] / 2.0 + 0.03, size[1] / 2.0 + 0.03),
-                            yaw: yaw_deg.to_radians(),
-                        },
-                        Material::flat([30, 30, 32]),
-                        0,
-                    ));
-                    moving.push(Moving::Monitor {
-                        rect: Shape::Rect {
-                            center: center + facing * 0.001,
-                            u,
-                            v,
-                        },
-                        color: *color,
-                        period_s: *bar_period_s,
-                    });
-                }
-                DynamicSpec::Plant {
-                    at,
-                    height,
-                    radius,
-                    color,
-                    sway_m,
-                    period_s,
-                } => {
-                    statics.push(Primitive::new(
-                        Shape::Cylinder {
-                            x: at[0],
-                            y: at[1],
-                            z0: 0.0,
-                            z1: 0.35,
-                            r: radius * 0.5,
-                        },
-                        Material::flat([150, 80, 50]),
-                        0,
-                    ));
-                    moving.push(Moving::Plant {
-                        base: *at,
-                        height: *height,
-                        radius: *radius,
-                        color: *color,
-                        sway_m: *sway_m,
-                        period_s: *period_s,
-                    });
-                }
-                DynamicSpec::Traffic {
-                    y,
-                    x_range,
-                    speed,
-                    every_s,
-                    size,
-                } => {
-                    let mut r = rng::stream(s.scenario.seed, "traffic", session);
-                    let palette: [Rgb; 6] = [
-                        [180, 30, 30],
-                        [30, 60, 160],
-                        [220, 220, 220],
-                        [40, 40, 40],
-                        [200, 160, 40],
-                        [90, 140, 90],
-                    ];
-                    let colors = (0..64)
-                        .map(|_| palette[r.random_range(0..palette.len())])
-                        .collect();
-                    moving.push(Moving::Traffic {
-                        y: *y,
-                        x_range: *x_range,
-                        speed: *speed,
-                        every_s: *every_s,
-                        size: *size,
-                        colors,
-                    });
-                }
-            }
-        }
+        let moving = moving_background(s, session, &mut statics);
         let sun = if w.kind == WorldKind::Outdoor {
             Vector3::new(0.4, 0.3, 0.87).normalize()
         } else {

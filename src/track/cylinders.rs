@@ -47,6 +47,10 @@ use nalgebra::{Matrix4x6, Matrix6, Point2, Point3, SMatrix, Vector4, Vector6};
 use super::kalman::{Kalman, constant_velocity_2d};
 use crate::geometry::triangulate::{CalibratedView, triangulate_rays};
 
+mod head;
+
+pub use head::{box_head_px, cylinder_radius};
+
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CylinderError {
     #[error("bad parameter `{name}`: {reason}")]
@@ -200,79 +204,6 @@ impl Hypothesis {
             Selection::Mean => self.e_m_px.max(E_M_FLOOR_PX),
         }
     }
-}
-
-/// The head pixel of a person's image box (our addition; the paper's templates give the head
-/// directly): the point of the box's top row on the image of the vertical line through the
-/// person. That line is found by casting the ray through the box centre to the height
-/// `centre_height_m` (about half a person's height; the result barely depends on it) and
-/// projecting the vertical through that ground point, with the lens distortion.
-///
-/// Why not the top centre of the box: away from the image centre of a wide, tilted corner
-/// camera a standing person's image leans, so the box's horizontal centre lies between the
-/// head and the feet — on `multicam_office` the top centre is 6.7 px (0.21 box widths) from
-/// the projected head top of fully visible people, about 0.12 m on the ground. Falls back to
-/// the top centre when the line does not cross the top row (`None` only for a box without a
-/// ray).
-pub fn box_head_px(
-    view: &CalibratedView,
-    bbox: [f64; 4],
-    centre_height_m: f64,
-) -> Option<[f64; 2]> {
-    let top_centre = [(bbox[0] + bbox[2]) / 2.0, bbox[1]];
-    // a box cut by the left or right image border is not centred on the person
-    let (w, _) = view.model.size();
-    if bbox[0] <= 1.0 || bbox[2] >= f64::from(w) - 1.0 {
-        return Some(top_centre);
-    }
-    let centre = Point2::new(top_centre[0], (bbox[1] + bbox[3]) / 2.0);
-    let (o, d) = view.ray_in_world(&centre)?;
-    if d.z.abs() < 1e-9 {
-        return Some(top_centre);
-    }
-    let t = (centre_height_m - o.z) / d.z;
-    if t <= 0.0 {
-        return Some(top_centre);
-    }
-    let g = o + d * t;
-    // image row of the vertical at height z; rows decrease upwards for a camera above the
-    // point, so bracket the top row between the centre height and the camera height
-    let at = |z: f64| view.project(&Point3::new(g.x, g.y, z));
-    let row = |z: f64| at(z).map(|p| p.y - bbox[1]);
-    let (mut lo, mut hi) = (centre_height_m, (o.z - 0.05).max(centre_height_m));
-    match (row(lo), row(hi)) {
-        (Some(a), Some(b)) if a >= 0.0 && b <= 0.0 => {}
-        _ => return Some(top_centre),
-    }
-    for _ in 0..50 {
-        let mid = 0.5 * (lo + hi);
-        match row(mid) {
-            Some(r) if r > 0.0 => lo = mid,
-            Some(_) => hi = mid,
-            None => return Some(top_centre),
-        }
-    }
-    at(0.5 * (lo + hi)).map(|p| [p.x, p.y])
-}
-
-/// The cylinder radius of eq. 6–7 from a triangulated head and its supporting 2-D objects
-/// `(view, raw head pixel, box width in pixels)`.
-pub fn cylinder_radius(head_m: &Point3<f64>, support: &[(&CalibratedView, [f64; 2], f64)]) -> f64 {
-    if support.is_empty() {
-        return f64::NAN;
-    }
-    let mut sum = 0.0;
-    for (view, head_px, width_px) in support {
-        let (beta, principal) = view.focal_and_principal();
-        let ideal = view
-            .ideal_px(&Point2::new(head_px[0], head_px[1]))
-            .unwrap_or(Point2::new(head_px[0], head_px[1]));
-        let d = (ideal - principal).norm() / beta;
-        let alpha = d.atan();
-        let dist = (view.center() - head_m).norm();
-        sum += 0.5 * (width_px / beta) * alpha.cos().powi(2) * dist;
-    }
-    sum / support.len() as f64
 }
 
 /// One tracked person as the tracker reports it after a frame.
@@ -590,18 +521,32 @@ impl CylinderTracker {
     pub fn step(&mut self, objects: &[Object2d]) -> (Vec<Cylinder>, StepStats) {
         let mut stats = StepStats::default();
         let prepared = self.prepare(objects);
+        let (f, q) = self.transition();
+        let mut used = self.update_objects(&prepared, (&f, &q), &mut stats);
+        let selected = self.select_new(&prepared, &mut used, &mut stats);
+        self.continue_candidates(selected, (&f, &q), &mut stats);
+        (self.cylinders(), stats)
+    }
+
+    /// Step 1: predict every object, then update it with the best combination differing in at
+    /// most one 2-D object from its support; objects missed for N_dis frames (or coasting
+    /// out of the room) are dropped. Returns which prepared 2-D objects were used.
+    fn update_objects(
+        &mut self,
+        prepared: &[Prepared],
+        transition: (&Matrix6<f64>, &Matrix6<f64>),
+        stats: &mut StepStats,
+    ) -> Vec<bool> {
         let index: BTreeMap<(usize, u32), usize> = prepared
             .iter()
             .enumerate()
             .map(|(i, p)| ((p.camera, p.id), i))
             .collect();
-        let (f, q) = self.transition();
+        let (f, q) = transition;
         let sel = self.params.selection;
-
-        // 1. update existing objects with combinations differing in at most one 2-D object
         let mut options: Vec<(f64, usize, Vec<usize>, Hypothesis)> = Vec::new();
         for obj in self.objects.iter_mut() {
-            obj.kf.predict(&f, &q);
+            obj.kf.predict(f, q);
             obj.age += 1;
         }
         for (k, obj) in self.objects.iter().enumerate() {
@@ -630,7 +575,7 @@ impl CylinderTracker {
             for mut c in combos {
                 c.sort_by_key(|&i| prepared[i].camera);
                 stats.combinations += usize::from(c.len() >= self.params.min_cameras);
-                if let Some(h) = self.evaluate(&prepared, &c)
+                if let Some(h) = self.evaluate(prepared, &c)
                     && (h.head_m.x - px).hypot(h.head_m.y - py) <= self.params.gate_m
                 {
                     options.push((h.score(sel), k, c, h));
@@ -675,14 +620,24 @@ impl CylinderTracker {
         }
         self.objects = kept;
         stats.discarded = discarded;
+        used
+    }
 
-        // 2. new objects among the 2-D objects that support none
+    /// Step 2: new hypotheses among the 2-D objects that support no object, best first, each
+    /// 2-D object in at most one; marks the ones it takes in `used`.
+    fn select_new(
+        &self,
+        prepared: &[Prepared],
+        used: &mut [bool],
+        stats: &mut StepStats,
+    ) -> Vec<Hypothesis> {
+        let sel = self.params.selection;
         let free: Vec<usize> = (0..prepared.len()).filter(|&i| !used[i]).collect();
-        let combos = self.combinations(&prepared, &free, &mut stats);
+        let combos = self.combinations(prepared, &free, stats);
         stats.combinations += combos.len();
         let mut valid: Vec<(f64, Vec<usize>, Hypothesis)> = combos
             .into_iter()
-            .filter_map(|c| self.evaluate(&prepared, &c).map(|h| (h.score(sel), c, h)))
+            .filter_map(|c| self.evaluate(prepared, &c).map(|h| (h.score(sel), c, h)))
             .collect();
         valid.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let mut selected = Vec::new();
@@ -695,7 +650,17 @@ impl CylinderTracker {
             }
             selected.push(h);
         }
-        // 3. candidates: continued when this frame's selection differs in at most one object
+        selected
+    }
+
+    /// Step 3: candidates are continued when this frame's selection differs in at most one
+    /// object from theirs, and promoted to objects after N_app frames.
+    fn continue_candidates(
+        &mut self,
+        selected: Vec<Hypothesis>,
+        (f, q): (&Matrix6<f64>, &Matrix6<f64>),
+        stats: &mut StepStats,
+    ) {
         let old = std::mem::take(&mut self.candidates);
         let mut taken = vec![false; old.len()];
         let mut next = Vec::new();
@@ -711,7 +676,7 @@ impl CylinderTracker {
                 Some((_, j)) => {
                     taken[j] = true;
                     let mut c = old[j].clone();
-                    c.kf.predict(&f, &q);
+                    c.kf.predict(f, q);
                     self.measure(&mut c.kf, &h);
                     c.count += 1;
                     c.support = h.support.clone();
@@ -742,7 +707,10 @@ impl CylinderTracker {
             }
         }
         self.candidates = next;
+    }
 
+    /// Every 3-D object alive (supported or coasting), sorted by id.
+    fn cylinders(&self) -> Vec<Cylinder> {
         let mut out: Vec<Cylinder> = self
             .objects
             .iter()
@@ -764,340 +732,9 @@ impl CylinderTracker {
             })
             .collect();
         out.sort_by_key(|c| c.id);
-        (out, stats)
+        out
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::geometry::camera::{CameraModel, Pinhole};
-    use crate::geometry::look_at;
-
-    pub(crate) fn office_views(distortion: bool) -> Vec<CalibratedView> {
-        [
-            ([0.15, 0.15, 2.85], [-0.24, 0.06, 0.0, 0.0, 0.0]),
-            ([7.85, 0.15, 2.85], [-0.22, 0.05, 0.0, 0.0, 0.0]),
-            ([7.85, 8.35, 2.85], [-0.25, 0.07, 0.0, 0.0, 0.0]),
-            ([0.15, 8.35, 2.85], [-0.23, 0.06, 0.0, 0.0, 0.0]),
-        ]
-        .iter()
-        .map(|(c, d)| {
-            let mut pin = Pinhole::from_fov(352, 288, 78.0);
-            if distortion {
-                pin.dist = *d;
-            }
-            CalibratedView::new(
-                CameraModel::Pinhole(pin),
-                look_at(Point3::from(*c), Point3::new(4.0, 4.25, 0.7)),
-            )
-        })
-        .collect()
-    }
-
-    /// Image box of a vertical cylinder (sampled rims and sides), raw pixels.
-    pub(crate) fn cylinder_box(
-        view: &CalibratedView,
-        x: f64,
-        y: f64,
-        h: f64,
-        r: f64,
-    ) -> Option<[f64; 4]> {
-        let mut b = [
-            f64::INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NEG_INFINITY,
-        ];
-        for k in 0..=40 {
-            let z = h * f64::from(k) / 40.0;
-            for a in 0..72 {
-                let t = f64::from(a) * std::f64::consts::TAU / 72.0;
-                let p = view.project(&Point3::new(x + r * t.cos(), y + r * t.sin(), z))?;
-                b = [b[0].min(p.x), b[1].min(p.y), b[2].max(p.x), b[3].max(p.y)];
-            }
-        }
-        Some(b)
-    }
-
-    fn objects_for(
-        views: &[CalibratedView],
-        people: &[(u32, f64, f64, f64, f64)],
-    ) -> Vec<Object2d> {
-        let mut out = Vec::new();
-        for (c, v) in views.iter().enumerate() {
-            for &(id, x, y, h, r) in people {
-                let head = v.project(&Point3::new(x, y, h)).expect("visible");
-                let b = cylinder_box(v, x, y, h, r).expect("visible");
-                out.push(Object2d {
-                    camera: c,
-                    id: id + 10 * c as u32,
-                    head_px: [head.x, head.y],
-                    width_px: b[2] - b[0],
-                });
-            }
-        }
-        out
-    }
-
-    #[test]
-    fn the_box_head_lies_on_the_projected_vertical_where_the_top_centre_does_not() {
-        // a person as a vertical cylinder seen by the distorted corner cameras: the head found
-        // on the box's top row lies near the image of the person's axis there (within 4 px;
-        // 0.58 px on average over these 20 views), the top centre 2.4 px on average (up to
-        // 5.6 px in the corners of the image); the box centre is only nearly on the axis
-        let views = office_views(true);
-        let (h, r) = (1.8, 0.2);
-        let (mut sum_axis, mut sum_top_centre) = (0.0, 0.0);
-        for v in &views {
-            for (x, y) in [(4.0, 4.25), (1.2, 6.5), (6.8, 1.6), (2.0, 2.0), (6.5, 7.2)] {
-                let b = cylinder_box(v, x, y, h, r).expect("visible");
-                let got = box_head_px(v, b, 0.9).expect("ray");
-                // the top of the box is the far rim of the top disk, a little above the axis
-                // top: compare along the row of the box top
-                let axis_x_at_top = {
-                    let (mut lo, mut hi) = (h, 2.8);
-                    for _ in 0..60 {
-                        let mid = 0.5 * (lo + hi);
-                        let p = v.project(&Point3::new(x, y, mid)).expect("visible");
-                        if p.y > b[1] { lo = mid } else { hi = mid }
-                    }
-                    v.project(&Point3::new(x, y, lo)).expect("visible").x
-                };
-                assert!((got[1] - b[1]).abs() < 1e-6, "{got:?} {b:?}");
-                // the box centre is only nearly on the axis (perspective and distortion make
-                // the projected cylinder asymmetric): within a pixel of it
-                let off = (got[0] - axis_x_at_top).abs();
-                let top_centre_off = ((b[0] + b[2]) / 2.0 - axis_x_at_top).abs();
-                eprintln!(
-                    "({x}, {y}): axis head {off:.2} px, top centre {top_centre_off:.2} px off"
-                );
-                assert!(off < 4.0, "{} vs {axis_x_at_top}", got[0]);
-                sum_axis += off;
-                sum_top_centre += top_centre_off;
-            }
-        }
-        assert!(
-            sum_top_centre > 2.0 * sum_axis,
-            "{sum_top_centre} vs {sum_axis}"
-        );
-        // a ray that never reaches the centre height falls back to the top centre
-        let v = &views[0];
-        let sky = [170.0, 0.0, 180.0, 2.0];
-        assert_eq!(box_head_px(v, sky, 0.9), Some([175.0, 0.0]));
-    }
-
-    #[test]
-    fn eq6_inverts_a_fronto_parallel_disk_exactly() {
-        // A disk of radius R facing the camera, centred on the optical axis at distance D, images
-        // as a circle of radius f·R/D around the principal point: α = 0 and eq. 6 gives R.
-        let views = office_views(false);
-        let v = &views[0];
-        let (f, p) = v.focal_and_principal();
-        let axis = v.world_from_camera.rotation * nalgebra::Vector3::z();
-        let (d, r) = (4.3, 0.23);
-        let centre = v.center() + axis * d;
-        let w = 2.0 * f * r / d;
-        let got = cylinder_radius(&centre, &[(v, [p.x, p.y], w)]);
-        assert!((got - r).abs() < 1e-12, "{got}");
-    }
-
-    #[test]
-    fn eq6_inverts_the_box_of_a_standing_cylinder_seen_by_a_level_camera() {
-        // A level camera at head height sees a vertical cylinder (radius R, axis at horizontal
-        // distance D, azimuth α off the optical axis) as a box bounded by two vertical lines,
-        // the images of the tangent rays at azimuths α ± δ, δ = asin(R/D); the head is at
-        // (β·tan α, 0) from the principal point. Its width w = β·(tan(α+δ) − tan(α−δ)), and
-        // eq. 6 gives ½·(tan(α+δ) − tan(α−δ))·cos²α·D, which is R up to O((R/D)²): within
-        // 1 % here. Without the cos²α factor it would be off by 1/cos²α (33 % at 30°).
-        let pin = Pinhole::from_fov(352, 288, 78.0);
-        let (h, r) = (1.7, 0.22);
-        for d in [3.0, 4.5, 6.0] {
-            for alpha_deg in [0.0f64, 10.0, 20.0, 30.0] {
-                let a = alpha_deg.to_radians();
-                let eye = Point3::new(0.0, 0.0, h);
-                let view = CalibratedView::new(
-                    CameraModel::Pinhole(pin.clone()),
-                    look_at(eye, Point3::new(1.0, 0.0, h)),
-                );
-                let (x, y) = (d * a.cos(), d * a.sin());
-                let head = Point3::new(x, y, h);
-                let px = view.project(&head).expect("head visible");
-                // the box: extreme columns of the densely sampled rim (any height: the
-                // outline is vertical)
-                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-                for k in 0..36_000 {
-                    let t = f64::from(k) * std::f64::consts::TAU / 36_000.0;
-                    let p = view
-                        .project(&Point3::new(x + r * t.cos(), y + r * t.sin(), 0.5))
-                        .expect("visible");
-                    lo = lo.min(p.x);
-                    hi = hi.max(p.x);
-                }
-                let got = cylinder_radius(&head, &[(&view, [px.x, px.y], hi - lo)]);
-                let delta = (r / d).asin();
-                let closed = 0.5 * ((a + delta).tan() - (a - delta).tan()) * a.cos().powi(2) * d;
-                assert!(
-                    (got - closed).abs() < 1e-6,
-                    "D {d} α {alpha_deg}: {got} vs {closed}"
-                );
-                assert!((got - r).abs() / r < 0.01, "D {d} α {alpha_deg}: {got}");
-            }
-        }
-    }
-
-    #[test]
-    fn eq6_on_the_office_cameras_is_a_biased_approximation() {
-        // The same cylinder seen from the office's corner cameras (2.85 m, looking down):
-        // the box is spread by the perspective of the whole 1.75 m body, which eq. 6 (a
-        // small-object, radial approximation at the head) does not model, so it
-        // overestimates, most for a near camera looking steeply down. Measured bounds:
-        // asserted so that a change in eq. 6 or the projection shows.
-        let views = office_views(false);
-        let (h, r) = (1.75, 0.22);
-        for &(x, y) in &[(4.0, 4.25), (2.5, 6.0), (6.0, 2.0), (3.0, 2.0)] {
-            let head = Point3::new(x, y, h);
-            let mut support = Vec::new();
-            for v in &views {
-                let px = v.project(&head).expect("head visible");
-                let b = cylinder_box(v, x, y, h, r).expect("visible");
-                let one = cylinder_radius(&head, &[(v, [px.x, px.y], b[2] - b[0])]);
-                eprintln!("({x}, {y}) camera at {}: R = {one:.4}", v.center());
-                assert!(one > 0.9 * r && one < 1.6 * r, "({x}, {y}): {one}");
-                support.push((v, [px.x, px.y], b[2] - b[0]));
-            }
-            let all = cylinder_radius(&head, &support);
-            eprintln!("({x}, {y}) mean over cameras: R = {all:.4}");
-            assert!(all > 0.95 * r && all < 1.3 * r, "({x}, {y}): {all}");
-        }
-    }
-
-    #[test]
-    fn noise_free_people_are_promoted_after_n_app_frames_and_tracked() {
-        let views = office_views(true);
-        let params = CylinderParams::default();
-        let mut t = CylinderTracker::new(views.clone(), params).expect("tracker");
-        let mut first_seen = None;
-        for k in 0..40u32 {
-            let s = f64::from(k) * 0.04;
-            let people = [(1, 2.0 + s, 3.0, 1.75, 0.22), (2, 6.0 - s, 5.5, 1.62, 0.2)];
-            let (cyl, _) = t.step(&objects_for(&views, &people));
-            if !cyl.is_empty() && first_seen.is_none() {
-                first_seen = Some(k);
-            }
-            if k >= 10 {
-                assert_eq!(cyl.len(), 2, "frame {k}: {cyl:?}");
-                for p in &people {
-                    // ids follow promotion order, not the people's order: nearest cylinder
-                    let c = cyl
-                        .iter()
-                        .min_by(|a, b| {
-                            let da = (a.x_m - p.1).hypot(a.y_m - p.2);
-                            let db = (b.x_m - p.1).hypot(b.y_m - p.2);
-                            da.total_cmp(&db)
-                        })
-                        .expect("two cylinders");
-                    assert!((c.x_m - p.1).hypot(c.y_m - p.2) < 0.05, "{c:?}");
-                    assert!((c.height_m - p.3).abs() < 0.02);
-                    assert_eq!(c.support.len(), 4, "all four cameras support");
-                    assert!(c.measured.as_ref().is_some_and(|m| m.e_m_px < 1e-6));
-                }
-            }
-        }
-        // promoted on the N_app-th frame (index N_app − 1)
-        assert_eq!(first_seen, Some(params.n_app - 1));
-    }
-
-    #[test]
-    fn an_object_is_discarded_after_n_dis_frames_without_support() {
-        let views = office_views(false);
-        let params = CylinderParams {
-            n_app: 2,
-            n_dis: 3,
-            ..Default::default()
-        };
-        let mut t = CylinderTracker::new(views.clone(), params).expect("tracker");
-        let objs = objects_for(&views, &[(1, 4.0, 4.0, 1.8, 0.2)]);
-        for _ in 0..3 {
-            t.step(&objs);
-        }
-        assert_eq!(t.step(&[]).0.len(), 1);
-        assert_eq!(t.step(&[]).0.len(), 1);
-        assert!(t.step(&[]).0.is_empty());
-    }
-
-    #[test]
-    fn a_coasting_object_is_dropped_when_its_prediction_leaves_the_room() {
-        // a (fast) person runs towards the x = 8 m wall and is then seen no more: the object
-        // coasts on its velocity, and is dropped as soon as it is predicted beyond the room's
-        // margin, long before N_dis; nothing is ever reported out there
-        let views = office_views(false);
-        let params = CylinderParams {
-            n_app: 2,
-            n_dis: 20,
-            ..Default::default()
-        };
-        let limit = params.room_m[2] + params.room_margin_m;
-        let mut t = CylinderTracker::new(views.clone(), params).expect("tracker");
-        for k in 0..8 {
-            let x = 4.2 + 0.4 * f64::from(k);
-            let (cyl, _) = t.step(&objects_for(&views, &[(1, x, 4.0, 1.8, 0.2)]));
-            assert!(k < 1 || cyl.len() == 1, "frame {k}: {cyl:?}");
-        }
-        let mut coasted = 0;
-        loop {
-            let (cyl, stats) = t.step(&[]);
-            assert!(cyl.iter().all(|c| c.x_m <= limit), "{cyl:?}");
-            if cyl.is_empty() {
-                assert_eq!(stats.discarded, 1);
-                break;
-            }
-            coasted += 1;
-            assert!(coasted < 10, "still coasting: {cyl:?}");
-        }
-        // last measurement at 7.0 m, about 0.4 m a frame: 7.4, 7.8, 8.2 stay inside 8.5
-        assert!((2..=4).contains(&coasted), "{coasted}");
-    }
-
-    #[test]
-    fn corrected_error_prefers_more_cameras_and_mean_error_does_not() {
-        // every head a few pixels off: subsets of fewer cameras fit better (lower E_m), but
-        // E_c = E_m / 10^N_c still picks all four, one person, one object. Choosing by E_m
-        // takes the best-fitting pair instead, and the other two views then form a second
-        // object of their own: the same person counted twice (the paper's reason for E_c).
-        let views = office_views(false);
-        let mut objs = objects_for(&views, &[(1, 4.0, 4.0, 1.8, 0.2)]);
-        for (o, (dx, dy)) in objs
-            .iter_mut()
-            .zip([(2.0, 0.0), (0.0, -2.0), (0.0, 1.5), (3.0, 0.0)])
-        {
-            o.head_px[0] += dx;
-            o.head_px[1] += dy;
-        }
-        for sel in [Selection::Corrected, Selection::Mean] {
-            let params = CylinderParams {
-                n_app: 1,
-                selection: sel,
-                ..Default::default()
-            };
-            let mut t = CylinderTracker::new(views.clone(), params).expect("tracker");
-            let (cyl, _) = t.step(&objs);
-            let sizes: Vec<usize> = cyl.iter().map(|c| c.support.len()).collect();
-            match sel {
-                Selection::Corrected => assert_eq!(sizes, vec![4]),
-                Selection::Mean => assert_eq!(sizes, vec![2, 2], "{cyl:?}"),
-            }
-        }
-    }
-
-    #[test]
-    fn support_difference_counts_cameras() {
-        assert_eq!(support_difference(&[(0, 1), (1, 2)], &[(0, 1), (1, 2)]), 0);
-        assert_eq!(support_difference(&[(0, 1), (1, 2)], &[(0, 1), (1, 3)]), 1);
-        assert_eq!(
-            support_difference(&[(0, 1), (1, 2)], &[(0, 1), (1, 2), (2, 7)]),
-            1
-        );
-        assert_eq!(support_difference(&[(0, 1), (1, 2)], &[(0, 1), (2, 7)]), 2);
-    }
-}
+mod tests;

@@ -458,9 +458,22 @@ impl LocalTracker {
 
     /// Blobs to tracks, fragments, new tracks, misses and stillness.
     fn associate(&mut self, bins: &BinImage) {
+        let ellipses: Vec<Ellipse> = self.blobs.iter().map(Blob::ellipse).collect();
+        let (blob_owner, track_blobs, held) = self.match_blobs(&ellipses);
+        self.update_matched(bins, &ellipses, &track_blobs);
+        self.start_tracks(bins, &ellipses, &blob_owner, &held);
+    }
+
+    /// Each live track's nearest blob within the gate (greedy, nearest first), then the
+    /// fragments around matched blobs. Returns each blob's track, each track's blobs (its
+    /// main blob first) and the blobs held by a still person's colour track.
+    #[allow(clippy::type_complexity)]
+    fn match_blobs(
+        &self,
+        ellipses: &[Ellipse],
+    ) -> (Vec<Option<usize>>, Vec<Vec<usize>>, Vec<bool>) {
         let p = self.params;
         let gate2 = p.gate_sigma * p.gate_sigma;
-        let ellipses: Vec<Ellipse> = self.blobs.iter().map(Blob::ellipse).collect();
         let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
         let mut held = vec![false; self.blobs.len()];
         for (ti, t) in self.tracks.iter().enumerate() {
@@ -530,7 +543,18 @@ impl LocalTracker {
                 track_blobs[ti].push(bi);
             }
         }
-        // update matched tracks, count misses
+        (blob_owner, track_blobs, held)
+    }
+
+    /// Matched tracks take their blobs' merged region (back to blob mode); unmatched blob
+    /// tracks count a miss; a blob track that stood still hands over to the colour tracker.
+    fn update_matched(
+        &mut self,
+        bins: &BinImage,
+        ellipses: &[Ellipse],
+        track_blobs: &[Vec<usize>],
+    ) {
+        let p = self.params;
         for (ti, t) in self.tracks.iter_mut().enumerate() {
             if t.ended {
                 continue;
@@ -604,7 +628,17 @@ impl LocalTracker {
                 self.stats.handovers_still += 1;
             }
         }
-        // new tracks from the remaining blobs, in label order
+    }
+
+    /// New tracks from the blobs nobody took, in label order.
+    fn start_tracks(
+        &mut self,
+        bins: &BinImage,
+        ellipses: &[Ellipse],
+        blob_owner: &[Option<usize>],
+        held: &[bool],
+    ) {
+        let p = self.params;
         for (bi, b) in self.blobs.iter().enumerate() {
             if blob_owner[bi].is_some() || held[bi] {
                 continue;

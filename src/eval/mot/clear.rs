@@ -155,29 +155,7 @@ pub(super) fn accumulate(
     let mut ever_matched_hyp = vec![false; hyp_ids.len()];
     let mut tally = vec![ObjectTally::default(); gt_ids.len()];
     let mut events = Vec::new();
-    let mut c = ClearMot {
-        num_frames: frames.len() as u64,
-        num_objects: 0,
-        num_predictions: 0,
-        num_unique_objects: 0,
-        num_matches: 0,
-        num_switches: 0,
-        num_transfer: 0,
-        num_ascend: 0,
-        num_migrate: 0,
-        num_false_positives: 0,
-        num_misses: 0,
-        num_detections: 0,
-        num_fragmentations: 0,
-        mostly_tracked: 0,
-        partially_tracked: 0,
-        mostly_lost: 0,
-        total_distance: 0.0,
-        mota: f64::NAN,
-        motp: f64::NAN,
-        recall: f64::NAN,
-        precision: f64::NAN,
-    };
+    let mut c = empty_counts(frames.len() as u64);
     let mut gt_done = Vec::new();
     let mut hyp_done = Vec::new();
     for f in frames {
@@ -281,6 +259,41 @@ pub(super) fn accumulate(
         c.num_objects += ng as u64;
         c.num_predictions += nh as u64;
     }
+    count_objects(&tally, &mut c);
+    c.num_detections = c.num_matches + c.num_switches;
+    (c.finish(), events)
+}
+
+/// Every count zero and every ratio NaN, for `num_frames` frames.
+fn empty_counts(num_frames: u64) -> ClearMot {
+    ClearMot {
+        num_frames,
+        num_objects: 0,
+        num_predictions: 0,
+        num_unique_objects: 0,
+        num_matches: 0,
+        num_switches: 0,
+        num_transfer: 0,
+        num_ascend: 0,
+        num_migrate: 0,
+        num_false_positives: 0,
+        num_misses: 0,
+        num_detections: 0,
+        num_fragmentations: 0,
+        mostly_tracked: 0,
+        partially_tracked: 0,
+        mostly_lost: 0,
+        total_distance: 0.0,
+        mota: f64::NAN,
+        motp: f64::NAN,
+        recall: f64::NAN,
+        precision: f64::NAN,
+    }
+}
+
+/// Per-object counts over the run: unique objects, fragmentations and the mostly tracked /
+/// partially tracked / mostly lost classes.
+fn count_objects(tally: &[ObjectTally], c: &mut ClearMot) {
     for t in tally.iter().filter(|t| t.frames > 0) {
         c.num_unique_objects += 1;
         c.num_fragmentations += t.fragmentations;
@@ -293,8 +306,6 @@ pub(super) fn accumulate(
             c.mostly_lost += 1;
         }
     }
-    c.num_detections = c.num_matches + c.num_switches;
-    (c.finish(), events)
 }
 
 /// Append a MATCH or SWITCH event for frame-local pair `(i, j)` and count it.

@@ -1,0 +1,225 @@
+//! What a figure shows: the kinds of figure, their series, marks and overlays, and the house
+//! palette. Plain data; the sibling `draw` renders it.
+
+use image::RgbImage;
+use plotters::style::RGBColor;
+
+/// Okabe–Ito: black, orange, sky blue, bluish green, blue, vermillion, reddish purple, yellow
+/// (yellow last: it is hard to read as a thin line on white).
+pub const PALETTE: [RGBColor; 8] = [
+    RGBColor(0, 0, 0),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 158, 115),
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(204, 121, 167),
+    RGBColor(240, 228, 66),
+];
+
+pub fn color(i: usize) -> RGBColor {
+    PALETTE[i % PALETTE.len()]
+}
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mark {
+    Line,
+    Points,
+    LinePoints,
+    Dashed,
+}
+
+/// One named series.
+#[derive(Debug, Clone)]
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+    pub mark: Mark,
+    /// `(x, low, high)`: a shaded band (e.g. ±3σ).
+    pub band: Vec<(f64, f64, f64)>,
+    pub color: usize,
+}
+
+impl Series {
+    pub fn line(name: impl Into<String>, points: Vec<(f64, f64)>, color: usize) -> Series {
+        Series {
+            name: name.into(),
+            points,
+            mark: Mark::Line,
+            band: Vec::new(),
+            color,
+        }
+    }
+
+    pub fn points(name: impl Into<String>, points: Vec<(f64, f64)>, color: usize) -> Series {
+        Series {
+            mark: Mark::Points,
+            ..Series::line(name, points, color)
+        }
+    }
+
+    pub fn with_mark(mut self, mark: Mark) -> Series {
+        self.mark = mark;
+        self
+    }
+
+    pub fn with_band(mut self, band: Vec<(f64, f64, f64)>) -> Series {
+        self.band = band;
+        self
+    }
+}
+
+/// A vertical mark at `x` with a label (occlusion, reset, ...).
+#[derive(Debug, Clone)]
+pub struct Event {
+    pub x: f64,
+    pub label: String,
+    pub color: usize,
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct LinePlot {
+    pub x_label: String,
+    pub y_label: String,
+    pub series: Vec<Series>,
+    pub events: Vec<Event>,
+    /// Fixed axis ranges; `None` fits the data.
+    pub x_range: Option<(f64, f64)>,
+    pub y_range: Option<(f64, f64)>,
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct ScatterPlot {
+    pub x_label: String,
+    pub y_label: String,
+    pub series: Vec<Series>,
+    /// Text in the upper left (e.g. `r = 0.93`).
+    pub annotation: String,
+    /// Least-squares line through all points.
+    pub fit_line: bool,
+}
+
+/// Something placed in a top view.
+#[derive(Debug, Clone)]
+pub struct Sensor {
+    pub x: f64,
+    pub y: f64,
+    /// Heading (rad, counter-clockwise from +x); `None` draws no arrow.
+    pub heading: Option<f64>,
+    pub label: String,
+}
+
+#[derive(Debug, Clone)]
+pub struct Circle {
+    pub x: f64,
+    pub y: f64,
+    pub r: f64,
+    pub color: usize,
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct TopView {
+    /// Closed outline of the room or area (metres).
+    pub outline: Vec<(f64, f64)>,
+    /// Filled obstacles (desks, trees...), each a closed polygon.
+    pub obstacles: Vec<Vec<(f64, f64)>>,
+    pub sensors: Vec<Sensor>,
+    pub trajectories: Vec<Series>,
+    pub circles: Vec<Circle>,
+}
+
+#[derive(Debug, Clone)]
+pub struct Bar {
+    pub label: String,
+    pub value: f64,
+    /// Half-length of the error bar (std or CI half-width); 0 for none.
+    pub error: f64,
+}
+
+/// `(bar i, bar j, label)` drawn as a bracket above the two bars.
+#[derive(Debug, Clone)]
+pub struct Significance {
+    pub i: usize,
+    pub j: usize,
+    pub label: String,
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct BarPlot {
+    pub y_label: String,
+    pub bars: Vec<Bar>,
+    pub significance: Vec<Significance>,
+}
+
+/// Shapes drawn over an image, in pixel coordinates.
+#[derive(Debug, Clone)]
+pub enum Overlay {
+    Box {
+        x0: f64,
+        y0: f64,
+        x1: f64,
+        y1: f64,
+        label: String,
+        color: usize,
+    },
+    Ellipse {
+        cx: f64,
+        cy: f64,
+        a: f64,
+        b: f64,
+        angle: f64,
+        color: usize,
+    },
+    Polyline {
+        points: Vec<(f64, f64)>,
+        closed: bool,
+        color: usize,
+    },
+    Point {
+        x: f64,
+        y: f64,
+        color: usize,
+    },
+}
+
+#[derive(Debug, Clone)]
+pub struct ImageOverlay {
+    pub image: RgbImage,
+    pub shapes: Vec<Overlay>,
+}
+
+#[derive(Debug, Clone)]
+pub enum FigureKind {
+    Lines(LinePlot),
+    Scatter(ScatterPlot),
+    TopView(TopView),
+    Bars(BarPlot),
+    Overlay(ImageOverlay),
+}
+
+/// A figure ready to render.
+#[derive(Debug, Clone)]
+pub struct Figure {
+    /// File stem: `<name>.png`, `<name>.svg`.
+    pub name: String,
+    pub title: String,
+    pub size: (u32, u32),
+    pub kind: FigureKind,
+}
+
+impl Figure {
+    pub fn new(name: impl Into<String>, title: impl Into<String>, kind: FigureKind) -> Figure {
+        let size = match &kind {
+            FigureKind::Overlay(o) => (o.image.width().max(64), o.image.height().max(64) + 30),
+            FigureKind::TopView(_) => (720, 720),
+            _ => (800, 500),
+        };
+        Figure {
+            name: name.into(),
+            title: title.into(),
+            size,
+            kind,
+        }
+    }
+}
