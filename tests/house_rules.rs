@@ -684,8 +684,8 @@ fn imports_against_the_layers_are_found_in_every_form() {
     assert_eq!(
         v,
         [
-            "(c) src/log/reader.rs:1: log (layer 2) imports report (layer 8, higher)",
-            "(c) src/log/reader.rs:2: log (layer 2) imports run (layer 9, higher)",
+            "(c) src/log/reader.rs:1: log (layer 2) imports report (layer 7, higher)",
+            "(c) src/log/reader.rs:2: log (layer 2) imports run (layer 8, higher)",
         ],
         "{v:?}"
     );

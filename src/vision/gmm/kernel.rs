@@ -142,6 +142,19 @@ fn above<S: Simd>(s: S, count: S::F, k: usize) -> S::M {
     s.lt(s.splat(k as f32), count)
 }
 
+/// Divide the first `most` weights by their sum `total` (0 where the sum vanishes). Slots
+/// past a lane's count are dead (never read before a new component overwrites them whole), so
+/// no lane mask is needed.
+#[inline(always)]
+fn renormalise<S: Simd>(s: S, grp: &mut Group<'_>, most: usize, total: S::F) {
+    let nonzero = s.lt(s.splat(f32::EPSILON), s.abs(total));
+    let inv = s.select(nonzero, s.div(s.splat(1.0), total), s.splat(0.0));
+    for k in 0..most {
+        let w = grp.get(s, k, 0);
+        grp.set(s, k, 0, s.mul(w, inv));
+    }
+}
+
 /// Update one group with the sample `x` (per channel); write the new component counts into
 /// `modes` and return the mask bytes.
 #[inline(always)]
@@ -233,14 +246,7 @@ fn update_group<S: Simd, const C: usize>(
         total = s.select(active, s.add(total, w_kept), total);
     }
 
-    // Renormalise the weights.
-    let nonzero = s.lt(s.splat(f32::EPSILON), s.abs(total));
-    let inv = s.select(nonzero, s.div(one, total), zero);
-    for k in 0..most {
-        // Slots past a lane's count are dead (see above), so no lane mask is needed.
-        let w = grp.get(s, k, 0);
-        grp.set(s, k, 0, s.mul(w, inv));
-    }
+    renormalise(s, grp, most, total);
 
     // A sample no component owns starts a new one (replacing the weakest when full).
     let new = if co.alpha > 0.0 {
