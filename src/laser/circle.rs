@@ -71,7 +71,8 @@ pub fn kasa(points: &[Point2<f64>]) -> Option<Circle> {
         .fold((f64::INFINITY, 0.0f64), |(lo, hi), &s| {
             (lo.min(s), hi.max(s))
         });
-    if !(lo > RANK_TOLERANCE * hi) {
+    let full_rank = lo > RANK_TOLERANCE * hi; // false on NaN
+    if !full_rank {
         return None;
     }
     let sol = svd.solve(&b, 0.0).ok()?;

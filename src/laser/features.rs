@@ -170,7 +170,8 @@ fn smallest_eigenvalue(m: &Matrix2<f64>) -> f64 {
 fn menger(a: Point2<f64>, b: Point2<f64>, c: Point2<f64>) -> f64 {
     let (ab, bc, ac) = ((b - a).norm(), (c - b).norm(), (c - a).norm());
     let denom = ab * bc * ac;
-    if !(denom > 0.0) {
+    let positive = denom > 0.0; // false on NaN
+    if !positive {
         return 0.0;
     }
     let cross = (b - a).x * (c - a).y - (b - a).y * (c - a).x;

@@ -144,7 +144,8 @@ pub fn leg(
         .map(|p| p.sensor.coords)
         .sum::<nalgebra::Vector2<f64>>()
         / seg.len() as f64;
-    if !(c.centre.coords.norm() > centroid.norm()) {
+    let faces_sensor = c.centre.coords.norm() > centroid.norm(); // false on NaN
+    if !faces_sensor {
         return None;
     }
     let (first, last) = (seg.first()?, seg.last()?);

@@ -80,8 +80,8 @@ pub fn segment(points: &[ScanPoint], options: &SegmentOptions) -> Vec<Segment> {
     for i in 1..=points.len() {
         let split = i == points.len() || {
             let (a, b) = (&points[i - 1], &points[i]);
-            b.beam != a.beam + 1
-                || !((b.sensor - a.sensor).norm() <= options.threshold.between(a, b))
+            let near = (b.sensor - a.sensor).norm() <= options.threshold.between(a, b); // NaN: false
+            b.beam != a.beam + 1 || !near
         };
         if split {
             if i - start >= options.min_points.max(1) {
