@@ -51,10 +51,9 @@ pub struct SegmentOptions {
 }
 
 impl Default for SegmentOptions {
-    /// Fixed 0.1 m and at least 3 points: the jump distance of the leg-detection literature
-    /// (Arras, Martínez Mozos & Burgard, ICRA 2007, use 0.15 m; Leigh et al. 2015's cluster
-    /// tolerance is 0.13 m), narrowed to 0.1 m, chosen on synthetic data so that two legs
-    /// 0.1–0.2 m apart stay separate segments; 3 points is the fewest a circle fits.
+    /// Fixed 0.1 m and at least 3 points. 0.1 m is chosen on synthetic data (two legs of one
+    /// person, 0.2 m apart, stay separate segments; a leg's own beams, a few cm apart, stay
+    /// together); 3 points is the fewest a circle fits.
     fn default() -> Self {
         SegmentOptions {
             threshold: Threshold::Fixed(0.1),
