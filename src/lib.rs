@@ -10,6 +10,7 @@ pub mod eval;
 pub mod frames;
 pub mod geometry;
 pub mod groundtruth;
+pub mod laser;
 pub mod learn;
 pub mod log;
 pub mod names;

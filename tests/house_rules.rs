@@ -28,7 +28,8 @@ const MAX_FN_LINES: usize = 150;
 ///    ground-truth contract; imports nothing, read by `frames`, `synth` and the pipelines);
 /// 2. `log` (session files; uses `time`, `geometry` for `CameraInfo` ↔ `CameraModel`);
 /// 3. `frames` (sensor frames decoded from a log, ground truth joined);
-/// 4. the stages' algorithms, which may share a layer: `calib`, `learn`, `vision`, `track`;
+/// 4. the stages' algorithms, which may share a layer: `calib`, `learn`, `vision`, `track`,
+///    `laser`;
 /// 5. `eval` (metrics and statistics: pure functions of data);
 /// 6. `synth` (writes logs through `log`; returns the preview's data, draws nothing);
 /// 7. `report` (tables, figures, the preview sheet drawn from `synth`'s data, atomic writes);
@@ -40,7 +41,7 @@ const LAYERS: &[&[&str]] = &[
     &["geometry", "groundtruth"],
     &["log"],
     &["frames"],
-    &["calib", "learn", "vision", "track"],
+    &["calib", "learn", "vision", "track", "laser"],
     &["eval"],
     &["synth"],
     &["report"],

@@ -1,0 +1,30 @@
+//! Laser people detection and multi-person tracking: pure functions of scans and poses.
+//!
+//! Data flow per scan (each step one file):
+//!
+//! 1. [`points`]: ranges + beam geometry + sensor pose → 2-D points in the sensor frame and in
+//!    the fixed (odometry/world) frame; no-returns (NaN, ±inf, 0.0, outside the range limits)
+//!    are skipped but every point keeps its beam index.
+//! 2. [`segment`]: jump-distance segmentation (fixed or range-adaptive threshold); a no-return
+//!    between two returns breaks a segment.
+//! 3. [`features`]: the per-segment geometric features of laser people detection, in a fixed
+//!    order for a later classifier; [`circle`] is the circle fit they use.
+//! 4. [`legs`]: the geometric leg model of seed 002 §3 (radius range, background jump, legs
+//!    paired into people within a pair distance, observation = midpoint).
+//! 5. [`tracker`]: multi-person tracking in the fixed frame (constant-velocity Kalman per
+//!    person from [`crate::track::kalman`], global nearest neighbour with a Mahalanobis gate
+//!    through [`crate::assign`], M-of-N initiation and deletion, single-leg updates).
+//!
+//! No file I/O and no `log`/`frames` imports: a pipeline turns a
+//! `frames::laser::LaserFrame` into [`points::ScanGeometry`] + ranges + pose. Nothing here
+//! panics on NaN or infinite input.
+
+pub mod circle;
+pub mod features;
+pub mod legs;
+pub mod points;
+pub mod segment;
+pub mod tracker;
+
+#[cfg(test)]
+mod tests;

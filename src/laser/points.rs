@@ -1,0 +1,160 @@
+//! Scan → 2-D points, in the sensor frame and in the fixed frame.
+//!
+//! Beam `k` has bearing `angle_min + k·angle_increment` (counter-clockwise from the sensor's
+//! x axis) and range `r_k`; its sensor-frame point is `(r cos θ, r sin θ)`. The fixed-frame
+//! point is the sensor pose (`fixed <- sensor`, a 3-D isometry) applied to `(x, y, 0)`, keeping
+//! `x, y` (exact for a level scanner; the projection onto the ground plane otherwise). Without
+//! a pose (logs without odometry) the fixed frame is the sensor frame.
+//!
+//! A beam is a **no return** when its range is NaN, ±inf, 0.0 or ≤ 0, or lies outside
+//! `[range_min, range_max]` (bounds inclusive, as drivers clamp to them). No-returns produce no
+//! point, but each point keeps its beam index, so [`crate::laser::segment`] sees the gap.
+
+use nalgebra::{Isometry3, Point2, Point3};
+
+/// The beam geometry of a scan (the `sensor_msgs/LaserScan` fields that place beams).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScanGeometry {
+    pub angle_min: f64,
+    pub angle_increment: f64,
+    pub range_min: f64,
+    pub range_max: f64,
+}
+
+impl ScanGeometry {
+    /// Bearing of beam `k` (rad).
+    pub fn angle(&self, k: usize) -> f64 {
+        self.angle_min + k as f64 * self.angle_increment
+    }
+
+    /// True when `r` is a real return (see the module doc).
+    pub fn is_return(&self, r: f64) -> bool {
+        r.is_finite() && r > 0.0 && r >= self.range_min && r <= self.range_max
+    }
+}
+
+/// One return.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScanPoint {
+    /// Index of the beam in the scan.
+    pub beam: usize,
+    pub range: f64,
+    pub angle: f64,
+    /// In the sensor frame (m).
+    pub sensor: Point2<f64>,
+    /// In the fixed frame (m); equal to `sensor` without a pose.
+    pub fixed: Point2<f64>,
+}
+
+/// The returns of one scan, in beam order. A pose with non-finite entries is treated as absent.
+pub fn project(
+    ranges: &[f32],
+    geometry: &ScanGeometry,
+    pose: Option<&Isometry3<f64>>,
+) -> Vec<ScanPoint> {
+    let pose = pose.filter(|p| pose_is_finite(p));
+    ranges
+        .iter()
+        .enumerate()
+        .filter_map(|(beam, &r)| {
+            let range = f64::from(r);
+            if !geometry.is_return(range) {
+                return None;
+            }
+            let angle = geometry.angle(beam);
+            let sensor = Point2::new(range * angle.cos(), range * angle.sin());
+            if !(sensor.x.is_finite() && sensor.y.is_finite()) {
+                return None;
+            }
+            Some(ScanPoint {
+                beam,
+                range,
+                angle,
+                sensor,
+                fixed: to_fixed(pose, sensor),
+            })
+        })
+        .collect()
+}
+
+/// A sensor-frame point in the fixed frame (identity without a pose).
+pub fn to_fixed(pose: Option<&Isometry3<f64>>, p: Point2<f64>) -> Point2<f64> {
+    match pose {
+        Some(pose) => {
+            let q = pose * Point3::new(p.x, p.y, 0.0);
+            Point2::new(q.x, q.y)
+        }
+        None => p,
+    }
+}
+
+fn pose_is_finite(p: &Isometry3<f64>) -> bool {
+    p.translation.vector.iter().all(|v| v.is_finite())
+        && p.rotation.coords.iter().all(|v| v.is_finite())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Translation3, UnitQuaternion};
+
+    fn geometry() -> ScanGeometry {
+        ScanGeometry {
+            angle_min: -std::f64::consts::FRAC_PI_2,
+            angle_increment: std::f64::consts::FRAC_PI_2,
+            range_min: 0.05,
+            range_max: 10.0,
+        }
+    }
+
+    #[test]
+    fn no_returns_are_skipped_and_beams_kept() {
+        let ranges = [
+            1.0,
+            f32::NAN,
+            2.0,
+            f32::INFINITY,
+            0.0,
+            0.01,
+            11.0,
+            f32::NEG_INFINITY,
+        ];
+        let g = ScanGeometry {
+            angle_increment: 0.1,
+            ..geometry()
+        };
+        let beams: Vec<usize> = project(&ranges, &g, None).iter().map(|p| p.beam).collect();
+        assert_eq!(beams, vec![0, 2]);
+    }
+
+    #[test]
+    fn sensor_and_fixed_points_follow_the_pose() {
+        // beams at -90°, 0°, +90°; pose: yaw +90° and translation (1, 2, 0.5)
+        let pose = Isometry3::from_parts(
+            Translation3::new(1.0, 2.0, 0.5),
+            UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+        );
+        let pts = project(&[1.0, 2.0, 3.0], &geometry(), Some(&pose));
+        let expect_sensor = [[0.0, -1.0], [2.0, 0.0], [0.0, 3.0]];
+        let expect_fixed = [[2.0, 2.0], [1.0, 4.0], [-2.0, 2.0]];
+        for (i, p) in pts.iter().enumerate() {
+            assert!(
+                (p.sensor - Point2::from(expect_sensor[i])).norm() < 1e-12,
+                "{p:?}"
+            );
+            assert!(
+                (p.fixed - Point2::from(expect_fixed[i])).norm() < 1e-12,
+                "{p:?}"
+            );
+        }
+        let no_pose = project(&[1.0, 2.0, 3.0], &geometry(), None);
+        assert!(no_pose.iter().all(|p| p.fixed == p.sensor));
+    }
+
+    #[test]
+    fn a_non_finite_pose_counts_as_absent() {
+        let pose = Isometry3::translation(f64::NAN, 0.0, 0.0);
+        let pts = project(&[1.0], &geometry(), Some(&pose));
+        assert_eq!(pts[0].fixed, pts[0].sensor);
+    }
+}
