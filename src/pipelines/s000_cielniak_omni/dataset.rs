@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use anyhow::Context;
 
-use super::tables::{self, HatRow, OmniRow, PoseRow, TargetRow, TruthRow};
+use super::tables::{self, HatRow, OmniRow, PoseRow, SkipRow, TargetRow, TruthRow};
 use crate::calib::external::{self, BearingCamera};
 use crate::run::Aggregate;
 
@@ -38,6 +38,28 @@ impl Inputs {
             sessions: ctx.sessions.len(),
         })
     }
+}
+
+/// A summary line on the messages the frames layer skipped in all sessions (none if none).
+pub fn skipped_summary(ctx: &Aggregate) -> anyhow::Result<Option<String>> {
+    let rows: Vec<(usize, SkipRow)> = tables::all(ctx, "skips")?;
+    Ok(skipped_line(&rows))
+}
+
+/// "N bad messages skipped (topic: n, …); first: <error>", topics merged over sessions.
+pub fn skipped_line(rows: &[(usize, SkipRow)]) -> Option<String> {
+    let first = rows.first()?;
+    let mut by_topic: BTreeMap<&str, i64> = BTreeMap::new();
+    for (_, r) in rows {
+        *by_topic.entry(r.topic.as_str()).or_default() += r.count;
+    }
+    let total: i64 = by_topic.values().sum();
+    let topics: Vec<String> = by_topic.iter().map(|(t, n)| format!("{t}: {n}")).collect();
+    Some(format!(
+        "{total} bad messages skipped ({}); first: {}",
+        topics.join(", "),
+        first.1.first_error
+    ))
 }
 
 /// Group the whole-hat detections by (session, stamp), in table order within a group.
@@ -215,6 +237,25 @@ mod tests {
         assert_eq!(seen.len(), 2);
         assert_eq!(seen[&(0, 5)], [(0, 10.0), (1, 20.0)]);
         assert_eq!(seen[&(1, 5)], [(3, 40.0)]);
+    }
+
+    #[test]
+    fn skipped_messages_are_summed_per_topic_over_sessions() {
+        let row = |topic: &str, count, e: &str| SkipRow {
+            topic: topic.into(),
+            count,
+            first_error: e.into(),
+        };
+        assert_eq!(skipped_line(&[]), None);
+        let rows = [
+            (0, row("/cam_0/image_raw", 2, "bad jpeg")),
+            (1, row("/cam_0/image_raw", 1, "other")),
+            (1, row("/a", 4, "x")),
+        ];
+        assert_eq!(
+            skipped_line(&rows).as_deref(),
+            Some("7 bad messages skipped (/a: 4, /cam_0/image_raw: 3); first: bad jpeg")
+        );
     }
 
     #[test]

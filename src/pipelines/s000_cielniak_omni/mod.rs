@@ -19,7 +19,9 @@
 //! comes from the ground-truth ids when present, otherwise from the halves of the session.
 //!
 //! Layout: [`params`]; the per-session stage in [`session`] (webcam hats, ground truth) and
-//! [`omni`] (panorama features), writing the row types of [`tables`]; the aggregation reads them
+//! [`omni`] (panorama features), reading the log through [`crate::frames`] (camera frames,
+//! rig cameras, ground truth; bad messages skipped and counted) and writing the row types of
+//! [`tables`]; the aggregation reads them
 //! into a [`dataset`], then runs one module per sub-experiment in the order of the paper:
 //! [`calibration`], [`angle`], [`splits`] (with the shared protocol of [`ann`]),
 //! [`correlations`], [`sweep`], [`person`], [`kalman`], [`truth_check`], [`estimates`].
@@ -57,7 +59,9 @@ pub struct OmniAppearance;
 
 impl Experiment for OmniAppearance {
     const KIND: &'static str = estimates::MODEL_KIND;
-    const VERSION: u32 = 1;
+    /// 2: the session stage reads through the frames layer (bad messages skipped and counted
+    /// in a `skips` table instead of failing the session).
+    const VERSION: u32 = 2;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {
@@ -100,6 +104,7 @@ impl Experiment for OmniAppearance {
 /// The aggregation: each sub-experiment in turn, adding its tables, figures and summary lines.
 fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     let mut out = Products::default();
+    out.summary.extend(dataset::skipped_summary(ctx)?);
     let loaded = estimates::load(p)?;
     if p.webcams.is_empty() {
         // no measurement system: only estimate positions with the loaded model

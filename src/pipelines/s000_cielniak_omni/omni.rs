@@ -4,8 +4,9 @@
 use anyhow::Context;
 
 use super::params::Params;
-use super::session::{first_info, for_each_frame};
+use super::session::{for_each_frame, rig_camera};
 use super::tables::{OmniRow, PoseRow};
+use crate::frames::Skips;
 use crate::geometry::camera::CameraModel;
 use crate::log::{SessionLog, TfBuffer};
 use crate::vision::omni::{Background, Unwrapper, features};
@@ -36,20 +37,19 @@ pub fn features_of(
     tf: &TfBuffer,
     t0: crate::Nanos,
     p: &Params,
+    skips: &mut Skips,
 ) -> anyhow::Result<(Vec<OmniRow>, PoseRow)> {
-    let info = first_info(log, &p.omni)?;
-    let model = info
+    let cam = rig_camera(log, tf, &p.omni, t0)?;
+    let model = cam
         .model()
         .with_context(|| format!("/{}/camera_info", p.omni))?;
     let unwrap = unwrapper(&model, p)?;
-    let omni_pose = tf
-        .lookup("map", &p.omni, t0)
-        .with_context(|| format!("no transform map <- {}", p.omni))?;
+    let omni_pose = cam.world_from_camera;
     let ox = omni_pose.rotation * nalgebra::Vector3::x();
     let mut bg_frames: Vec<Vec<f32>> = Vec::new();
     let mut background: Option<Background> = None;
     let mut rows = Vec::new();
-    for_each_frame(log, &p.omni, |stamp, img| {
+    for_each_frame(log, &p.omni, skips, |stamp, img| {
         let pano = unwrap.unwrap_grey(&img);
         if background.is_none() {
             bg_frames.push(pano);

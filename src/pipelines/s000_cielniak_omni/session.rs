@@ -6,60 +6,49 @@ use image::RgbImage;
 
 use super::omni;
 use super::params::Params;
-use super::tables::{CameraRow, CameraTruthRow, HatRow, TargetRow, TruthRow, frame};
+use super::tables::{CameraRow, CameraTruthRow, HatRow, SkipRow, TargetRow, TruthRow, frame};
 use crate::calib::external;
-use crate::groundtruth::{PEOPLE_TOPIC, PeopleFrame, TARGETS_TOPIC, TargetsFrame};
-use crate::log::msgs::{CameraInfo, CompressedImage, Image};
-use crate::log::{SessionLog, TfBuffer, read_topic};
+use crate::frames::{Skips, camera, rig, truth};
+use crate::groundtruth::{PEOPLE_TOPIC, TARGETS_TOPIC};
+use crate::log::{SessionLog, TfBuffer};
 use crate::progress::Progress;
 use crate::run::{Session, SessionTables};
 
-fn image_topic(log: &SessionLog, name: &str) -> Option<(String, bool)> {
-    let compressed = format!("/{name}/image_raw/compressed");
-    let raw = format!("/{name}/image_raw");
-    if log.summary().channel(&compressed).is_some() {
-        Some((compressed, true))
-    } else if log.summary().channel(&raw).is_some() {
-        Some((raw, false))
-    } else {
-        None
-    }
-}
-
-/// Every frame of a camera as `(header stamp ns, RGB image)`.
+/// Every frame of camera `name` as `(stamp ns, RGB image)`, through the frames layer; messages
+/// that do not decode are skipped and counted in `skips`.
 pub(super) fn for_each_frame(
     log: &SessionLog,
     name: &str,
+    skips: &mut Skips,
     mut f: impl FnMut(i64, RgbImage) -> anyhow::Result<()>,
 ) -> anyhow::Result<()> {
-    let (topic, compressed) =
-        image_topic(log, name).with_context(|| format!("no image topic for camera `{name}`"))?;
-    if compressed {
-        for item in read_topic::<CompressedImage>(log, &topic)? {
-            let (_, m) = item?;
-            let stamp = m.header.stamp.nanos().map_or(0, |n| n.0 as i64);
-            let img = crate::log::image::decode_compressed(&m)
-                .with_context(|| format!("{topic} at {stamp} ns"))?;
-            f(stamp, img.to_rgb8())?;
-        }
-    } else {
-        for item in read_topic::<Image>(log, &topic)? {
-            let (_, m) = item?;
-            let stamp = m.header.stamp.nanos().map_or(0, |n| n.0 as i64);
-            let img = crate::log::image::decode_raw(&m)
-                .with_context(|| format!("{topic} at {stamp} ns"))?;
-            f(stamp, img.to_rgb8())?;
-        }
+    let topic = camera::image_topic(log, name)
+        .with_context(|| format!("no image topic for camera `{name}`"))?;
+    let mut frames = camera::frames(log, &topic, None)?;
+    for fr in &mut frames {
+        let fr = fr?;
+        f(fr.stamp.0 as i64, fr.rgb)?;
     }
+    skips.merge(frames.into_skips());
     Ok(())
 }
 
-pub(super) fn first_info(log: &SessionLog, name: &str) -> anyhow::Result<CameraInfo> {
-    let topic = format!("/{name}/camera_info");
-    let (_, info) = read_topic::<CameraInfo>(log, &topic)?
-        .next()
-        .with_context(|| format!("{topic} has no messages"))??;
-    Ok(info)
+/// Camera `name` calibrated from its first `/<name>/camera_info` and its TF pose in `map` at
+/// `t0`.
+pub(super) fn rig_camera(
+    log: &SessionLog,
+    tf: &TfBuffer,
+    name: &str,
+    t0: crate::Nanos,
+) -> anyhow::Result<rig::RigCamera> {
+    Ok(rig::camera(
+        log,
+        tf,
+        name,
+        &format!("/{name}/camera_info"),
+        "map",
+        Some(t0),
+    )?)
 }
 
 /// All per-session tables of one log.
@@ -72,11 +61,21 @@ pub fn process(s: &Session, p: &Params, bar: &dyn Progress) -> anyhow::Result<Se
         .as_ref()
         .map_or(crate::Nanos(0), |st| st.start);
     bar.set_length((p.webcams.len() + 1) as u64);
-    let (cameras, hats) = webcams(log, &tf, t0, p, bar)?;
-    let (targets, truth) = ground_truth(log)?;
+    let mut skips = Skips::new();
+    let (cameras, hats) = webcams(log, &tf, t0, p, bar, &mut skips)?;
+    let (targets, truth) = ground_truth(log, &mut skips)?;
     bar.set_message("omni features");
-    let (omni, pose) = omni::features_of(log, &tf, t0, p)?;
+    let (omni, pose) = omni::features_of(log, &tf, t0, p, &mut skips)?;
     bar.inc(1);
+    let skipped: Vec<SkipRow> = skips
+        .rows()
+        .into_iter()
+        .map(|r| SkipRow {
+            topic: r.topic,
+            count: i64::try_from(r.count).unwrap_or(i64::MAX),
+            first_error: r.first_error,
+        })
+        .collect();
     Ok(SessionTables::from([
         ("cameras".to_string(), frame(&cameras)?),
         ("camera_truth".to_string(), frame(&camera_truth(log))?),
@@ -85,6 +84,7 @@ pub fn process(s: &Session, p: &Params, bar: &dyn Progress) -> anyhow::Result<Se
         ("truth".to_string(), frame(&truth)?),
         ("omni".to_string(), frame(&omni)?),
         ("omni_pose".to_string(), frame(&[pose])?),
+        ("skips".to_string(), frame(&skipped)?),
     ]))
 }
 
@@ -95,14 +95,13 @@ fn webcams(
     t0: crate::Nanos,
     p: &Params,
     bar: &dyn Progress,
+    skips: &mut Skips,
 ) -> anyhow::Result<(Vec<CameraRow>, Vec<HatRow>)> {
     let (mut cameras, mut hats) = (Vec::new(), Vec::new());
     for (k, name) in p.webcams.iter().enumerate() {
         bar.set_message(&format!("hats in {name}"));
-        let info = first_info(log, name)?;
-        let pose = tf
-            .lookup("map", name, t0)
-            .with_context(|| format!("no transform map <- {name}"))?;
+        let cam = rig_camera(log, tf, name, t0)?;
+        let (info, pose) = (&cam.info, cam.world_from_camera);
         let z = pose.rotation * nalgebra::Vector3::z();
         cameras.push(CameraRow {
             camera: name.clone(),
@@ -112,7 +111,7 @@ fn webcams(
             range: 2.0 * (f64::from(info.width) / 2.0 / info.k[0]).atan(),
             width: f64::from(info.width),
         });
-        for_each_frame(log, name, |stamp, img| {
+        for_each_frame(log, name, skips, |stamp, img| {
             if let Some(b) = external::find_hue_blob(
                 &img,
                 (p.hat_hue_deg[0], p.hat_hue_deg[1]),
@@ -136,35 +135,38 @@ fn webcams(
     Ok((cameras, hats))
 }
 
-/// The calibration marks and (when present) the simulator's people.
-fn ground_truth(log: &SessionLog) -> anyhow::Result<(Vec<TargetRow>, Vec<TruthRow>)> {
-    let mut targets = Vec::new();
-    if log.summary().channel(TARGETS_TOPIC).is_some() {
-        for m in log.messages_on(&[TARGETS_TOPIC])? {
-            let m = m?;
-            let f: TargetsFrame = serde_json::from_slice(&m.data)
-                .with_context(|| format!("{TARGETS_TOPIC} at {} s", m.log_time))?;
-            targets.extend(f.targets.iter().map(|t| TargetRow {
+/// The calibration marks and (when present) the simulator's people, in stamp order.
+fn ground_truth(
+    log: &SessionLog,
+    skips: &mut Skips,
+) -> anyhow::Result<(Vec<TargetRow>, Vec<TruthRow>)> {
+    let (marks, s) = truth::targets(log, TARGETS_TOPIC)?;
+    skips.merge(s);
+    let targets = marks
+        .items()
+        .iter()
+        .flat_map(|f| {
+            f.targets.iter().map(|t| TargetRow {
                 stamp: f.stamp_ns as i64,
                 x: t.x,
                 y: t.y,
-            }));
-        }
-    }
-    let mut truth = Vec::new();
-    if log.summary().channel(PEOPLE_TOPIC).is_some() {
-        for m in log.messages_on(&[PEOPLE_TOPIC])? {
-            let m = m?;
-            let f: PeopleFrame = serde_json::from_slice(&m.data)
-                .with_context(|| format!("{PEOPLE_TOPIC} at {} s", m.log_time))?;
-            truth.extend(f.people.iter().map(|q| TruthRow {
+            })
+        })
+        .collect();
+    let (people, s) = truth::people(log, PEOPLE_TOPIC)?;
+    skips.merge(s);
+    let truth = people
+        .items()
+        .iter()
+        .flat_map(|f| {
+            f.people.iter().map(|q| TruthRow {
                 stamp: f.stamp_ns as i64,
                 id: i64::from(q.id),
                 x: q.x,
                 y: q.y,
-            }));
-        }
-    }
+            })
+        })
+        .collect();
     Ok((targets, truth))
 }
 

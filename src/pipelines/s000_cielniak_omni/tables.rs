@@ -94,6 +94,16 @@ table_row! {
     }
 }
 
+table_row! {
+    /// Messages the frames layer skipped on one topic (they did not decode): `skips`.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct SkipRow {
+        pub topic: String,
+        pub count: i64,
+        pub first_error: String,
+    }
+}
+
 /// Rows of one table (none when the table is absent or has no columns).
 pub fn read<R: Rows>(tables: &SessionTables, name: &str) -> anyhow::Result<Vec<R>> {
     match tables.get(name) {
