@@ -19,8 +19,8 @@
 //! comes from the ground-truth ids when present, otherwise from the halves of the session.
 //!
 //! Layout: [`params`]; the per-session stage in [`session`] (webcam hats, ground truth) and
-//! [`omni`] (panorama features), reading the log through [`crate::frames`] (camera frames,
-//! rig cameras, ground truth; bad messages skipped and counted) and writing the row types of
+//! [`omni`] (panorama features), reading the log through [`crate::frames`] ([`sources`]:
+//! camera frames and rig cameras; ground truth; bad messages skipped and counted) and writing the row types of
 //! [`tables`]; the aggregation reads them
 //! into a [`dataset`], then runs one module per sub-experiment in the order of the paper:
 //! [`calibration`], [`angle`], [`splits`] (with the shared protocol of [`ann`]),
@@ -38,6 +38,7 @@ mod params;
 mod person;
 mod session;
 mod shared;
+mod sources;
 mod splits;
 mod sweep;
 mod tables;

@@ -4,7 +4,7 @@
 use anyhow::Context;
 
 use super::params::Params;
-use super::session::{for_each_frame, rig_camera};
+use super::sources::{for_each_frame, rig_camera};
 use super::tables::{OmniRow, PoseRow};
 use crate::frames::Skips;
 use crate::geometry::camera::CameraModel;

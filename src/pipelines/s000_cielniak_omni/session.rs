@@ -1,55 +1,16 @@
 //! The per-session stage: the webcams' hat measurements (section 3), the calibration marks and
 //! the simulator's truth when the log has them, and the omni camera's features (4.2–4.3).
 
-use anyhow::Context;
-use image::RgbImage;
-
 use super::omni;
 use super::params::Params;
+use super::sources::{for_each_frame, rig_camera};
 use super::tables::{CameraRow, CameraTruthRow, HatRow, SkipRow, TargetRow, TruthRow, frame};
 use crate::calib::external;
-use crate::frames::{Skips, camera, rig, truth};
+use crate::frames::{Skips, truth};
 use crate::groundtruth::{PEOPLE_TOPIC, TARGETS_TOPIC};
 use crate::log::{SessionLog, TfBuffer};
 use crate::progress::Progress;
 use crate::run::{Session, SessionTables};
-
-/// Every frame of camera `name` as `(stamp ns, RGB image)`, through the frames layer; messages
-/// that do not decode are skipped and counted in `skips`.
-pub(super) fn for_each_frame(
-    log: &SessionLog,
-    name: &str,
-    skips: &mut Skips,
-    mut f: impl FnMut(i64, RgbImage) -> anyhow::Result<()>,
-) -> anyhow::Result<()> {
-    let topic = camera::image_topic(log, name)
-        .with_context(|| format!("no image topic for camera `{name}`"))?;
-    let mut frames = camera::frames(log, &topic, None)?;
-    for fr in &mut frames {
-        let fr = fr?;
-        f(fr.stamp.0 as i64, fr.rgb)?;
-    }
-    skips.merge(frames.into_skips());
-    Ok(())
-}
-
-/// Camera `name` calibrated from its first `/<name>/camera_info` and its TF pose in `map` at
-/// `t0`.
-pub(super) fn rig_camera(
-    log: &SessionLog,
-    tf: &TfBuffer,
-    name: &str,
-    t0: crate::Nanos,
-) -> anyhow::Result<rig::RigCamera> {
-    Ok(rig::camera(
-        log,
-        tf,
-        name,
-        &format!("/{name}/camera_info"),
-        "map",
-        Some(t0),
-    )?)
-}
 
 /// All per-session tables of one log.
 pub fn process(s: &Session, p: &Params, bar: &dyn Progress) -> anyhow::Result<SessionTables> {
