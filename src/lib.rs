@@ -8,6 +8,7 @@ pub mod assign;
 pub mod calib;
 pub mod cli;
 pub mod eval;
+pub mod frames;
 pub mod geometry;
 pub mod groundtruth;
 pub mod learn;

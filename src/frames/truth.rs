@@ -1,0 +1,111 @@
+//! Ground truth of synthetic sessions ([`crate::groundtruth`]): the people frames and the
+//! calibration targets, read whole (they are small), sorted by their `stamp_ns` (ties keep log
+//! order), with bad JSON messages skipped and counted. [`Stamped`] is the sorted series with
+//! the nearest-stamp join ([`crate::log::sync::nearest`]: nearest stamp within the tolerance,
+//! ties to the earlier one).
+
+use super::skips::Skips;
+use crate::groundtruth::{PeopleFrame, TargetsFrame};
+use crate::log::{LogError, SessionLog, sync};
+use crate::time::Nanos;
+
+/// Items sorted by stamp, with nearest-stamp lookups.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stamped<T> {
+    stamps: Vec<Nanos>,
+    items: Vec<T>,
+}
+
+impl<T> Default for Stamped<T> {
+    fn default() -> Self {
+        Stamped {
+            stamps: Vec::new(),
+            items: Vec::new(),
+        }
+    }
+}
+
+impl<T> Stamped<T> {
+    /// Sort `(stamp, item)` pairs by stamp (stable: equal stamps keep their order).
+    pub fn new(mut pairs: Vec<(Nanos, T)>) -> Self {
+        pairs.sort_by_key(|p| p.0);
+        let (stamps, items) = pairs.into_iter().unzip();
+        Stamped { stamps, items }
+    }
+
+    /// The item whose stamp is nearest to `t`, if within `tolerance_ns` (ties: the earlier).
+    pub fn nearest(&self, t: Nanos, tolerance_ns: u64) -> Option<&T> {
+        sync::nearest(&self.stamps, t, tolerance_ns).map(|i| &self.items[i])
+    }
+
+    /// Like [`Self::nearest`], with the item's stamp.
+    pub fn nearest_with_stamp(&self, t: Nanos, tolerance_ns: u64) -> Option<(Nanos, &T)> {
+        sync::nearest(&self.stamps, t, tolerance_ns).map(|i| (self.stamps[i], &self.items[i]))
+    }
+
+    pub fn stamps(&self) -> &[Nanos] {
+        &self.stamps
+    }
+
+    pub fn items(&self) -> &[T] {
+        &self.items
+    }
+
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = (Nanos, &T)> {
+        self.stamps.iter().copied().zip(&self.items)
+    }
+
+    /// Drop every item (e.g. odometry of a camera that does not ride the robot).
+    pub fn clear(&mut self) {
+        self.stamps.clear();
+        self.items.clear();
+    }
+}
+
+/// Every JSON message of `topic` parsed as `T`, keyed by `stamp(&T)`, sorted. A topic absent
+/// from the log gives an empty series; a message that does not parse is skipped and counted
+/// (`<file>: topic <topic> at log time <s> s: <serde error>`).
+fn read_json<T: serde::de::DeserializeOwned>(
+    log: &SessionLog,
+    topic: &str,
+    stamp: impl Fn(&T) -> u64,
+) -> Result<(Stamped<T>, Skips), LogError> {
+    let mut pairs = Vec::new();
+    let mut skips = Skips::new();
+    if log.summary().channel(topic).is_none() {
+        return Ok((Stamped::default(), skips));
+    }
+    for m in log.messages_on(&[topic])? {
+        let m = m?;
+        match serde_json::from_slice::<T>(&m.data) {
+            Ok(f) => pairs.push((Nanos(stamp(&f)), f)),
+            Err(e) => skips.note(
+                topic,
+                format!(
+                    "{}: topic {topic} at log time {} s: {e}",
+                    log.path().display(),
+                    m.log_time
+                ),
+            ),
+        }
+    }
+    Ok((Stamped::new(pairs), skips))
+}
+
+/// The people frames of `topic` (normally [`crate::groundtruth::PEOPLE_TOPIC`]).
+pub fn people(log: &SessionLog, topic: &str) -> Result<(Stamped<PeopleFrame>, Skips), LogError> {
+    read_json(log, topic, |f: &PeopleFrame| f.stamp_ns)
+}
+
+/// The calibration targets of `topic` (normally [`crate::groundtruth::TARGETS_TOPIC`]).
+pub fn targets(log: &SessionLog, topic: &str) -> Result<(Stamped<TargetsFrame>, Skips), LogError> {
+    read_json(log, topic, |f: &TargetsFrame| f.stamp_ns)
+}
