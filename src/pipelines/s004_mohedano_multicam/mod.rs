@@ -19,6 +19,15 @@
 //! tracks written back into a copy of each log as `visualization_msgs/msg/MarkerArray`
 //! (cylinders and labels in the world frame) that Foxglove's 3-D and image panels draw over
 //! the cameras.
+//!
+//! Layout, in the direction data flows: `params` (the pipeline file's `[params]` and their
+//! checks); `session` (per session: calibration and camera frames through `crate::frames`, each
+//! camera's chain, the ground-truth-box run, the 3-D runs, the per-frame scores and the camera
+//! view for the figure) writes the row structs of `tables`, the only thing cached; `scored`
+//! reads them back and evaluates every run once; `evaluate` (one file per sub-experiment) and
+//! `figures` turn them into tables and figures; `aggregate` orders the products; `markers` is
+//! the `--write-tracks` export, the one step of aggregation that reads the logs, run only when
+//! asked.
 
 mod aggregate;
 mod evaluate;

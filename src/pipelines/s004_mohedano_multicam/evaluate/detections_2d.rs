@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 
 use crate::pipelines::s004_mohedano_multicam::scored::Scored;
-use crate::pipelines::s004_mohedano_multicam::session::DETECTION_HEAD_TOL;
+use crate::pipelines::s004_mohedano_multicam::session::{DETECTION_HEAD_TOL, MIN_BOX_HEIGHT_PX};
 use crate::pipelines::s004_mohedano_multicam::tables::Det2dRow;
 use crate::report::Table;
 use crate::report::rows::Rows;
@@ -95,7 +95,7 @@ pub(super) fn table(s: &Scored, summary: &mut Vec<String>) -> anyhow::Result<Opt
         .with_precision("head_dx_abs_px", 1)
         .with_precision("head_dy_px", 1)
         .with_precision("height_ratio", 2)
-        .with_note(format!("A detection matches a ground-truth person (the visible box, at least 8 px tall) when its head point lies within {DETECTION_HEAD_TOL} × the visible box width of the person's projected head top (from the log's ground truth; the box's top centre when the log has none) — the point the 3-D stage triangulates; IoU would punish the full-body template box of a person whose legs a desk hides — one to one, nearest first. Head offsets and height ratios are means over matched pairs: head_dy_px < 0 puts the detected head above the projected head top; height_ratio is the template's silhouette height over the visible box height (a desk hides the legs, so > 1 is expected there)."))
+        .with_note(format!("A detection matches a ground-truth person (the visible box, at least {MIN_BOX_HEIGHT_PX} px tall) when its head point lies within {DETECTION_HEAD_TOL} × the visible box width of the person's projected head top (from the log's ground truth; the box's top centre when the log has none) — the point the 3-D stage triangulates; IoU would punish the full-body template box of a person whose legs a desk hides — one to one, nearest first. Head offsets and height ratios are means over matched pairs: head_dy_px < 0 puts the detected head above the projected head top; height_ratio is the template's silhouette height over the visible box height (a desk hides the legs, so > 1 is expected there)."))
         .with_note("Paper: no detection numbers (fig. 3 shows the process on one frame)."),
     ))
 }

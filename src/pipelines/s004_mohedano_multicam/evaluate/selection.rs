@@ -123,9 +123,20 @@ mod tests {
     fn the_two_rules_side_by_side_with_their_support() {
         let s = testdata::scored();
         let rows = rows(&s);
-        // only templates ran both rules (testdata)
-        assert_eq!(rows.len(), 2);
-        let (ec, em) = (&rows[0], &rows[1]);
+        // gt_boxes ran E_c only, templates both rules (testdata)
+        let runs: Vec<(&str, &str)> = rows
+            .iter()
+            .map(|r| (r.detector.as_str(), r.selection.as_str()))
+            .collect();
+        assert_eq!(
+            runs,
+            [
+                ("gt_boxes", "E_c"),
+                ("templates", "E_c"),
+                ("templates", "E_m")
+            ]
+        );
+        let (ec, em) = (&rows[1], &rows[2]);
         assert_eq!(
             (ec.selection.as_str(), em.selection.as_str()),
             ("E_c", "E_m")
@@ -137,6 +148,7 @@ mod tests {
         assert_eq!((em.mota_lo, em.mota_hi, em.FN), (1.0, 1.0, 0));
         assert_eq!((ec.mean_cameras, em.mean_cameras), (3.0, 2.0));
         assert_eq!((ec.mean_E_m_px, em.mean_E_m_px), (2.0, 1.0));
+        // one line, for the detector with both rules
         assert_eq!(
             summary_lines(&rows, 1.0),
             [

@@ -1,17 +1,15 @@
 //! Boxes for the 2-D tracker: from a `Detection2DArray` or from the ground truth, with the
-//! head point each source gives them; the 2-D tracker's parameters; the ground truth nearest
-//! a frame.
+//! head point each source gives them; the 2-D tracker's parameters.
 
 use super::super::Params;
 use crate::geometry::triangulate::CalibratedView;
 use crate::groundtruth::PeopleFrame;
 use crate::log::msgs::Detection2DArray;
-use crate::time::Nanos;
 use crate::track::cylinders;
 use crate::track::graph_match::{Box2d, GraphParams};
 
 /// Ground-truth boxes lower or narrower than this (px) are not used.
-const MIN_BOX_HEIGHT_PX: f64 = 8.0;
+pub(crate) const MIN_BOX_HEIGHT_PX: f64 = 8.0;
 const MIN_BOX_WIDTH_PX: f64 = 2.0;
 
 pub(crate) fn graph_params(p: &Params, dt_s: f64) -> GraphParams {
@@ -99,14 +97,4 @@ pub(crate) fn boxes_from_truth(gt: &PeopleFrame, camera: &str, head: BoxHead) ->
         }
     }
     out
-}
-
-/// The ground-truth frame nearest `t` within `tol_ns` (`truth` sorted by stamp).
-pub(crate) fn nearest_truth(
-    truth: &[(Nanos, PeopleFrame)],
-    t: Nanos,
-    tol_ns: u64,
-) -> Option<&PeopleFrame> {
-    let stamps: Vec<Nanos> = truth.iter().map(|x| x.0).collect();
-    crate::log::sync::nearest(&stamps, t, tol_ns).map(|i| &truth[i].1)
 }

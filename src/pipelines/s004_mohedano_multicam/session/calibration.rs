@@ -1,53 +1,21 @@
-//! The cameras of one session: each camera's first `CameraInfo` and its pose in the world
-//! frame from TF.
-
-use anyhow::Context;
+//! The cameras of one session (through `frames::rig`) and their positions as a table.
 
 use super::super::{Params, Topics};
+use crate::frames::rig;
 use crate::geometry::triangulate::CalibratedView;
-use crate::log::msgs::CameraInfo;
-use crate::log::{SessionLog, TfBuffer, read_topic};
+use crate::log::{SessionLog, TfBuffer};
 use crate::pipelines::s004_mohedano_multicam::tables::CalibRow;
-use crate::time::Nanos;
 
-/// The cameras of one session with their calibration.
-#[derive(Debug, Clone)]
-pub(crate) struct Calibration {
-    pub views: Vec<CalibratedView>,
-}
-
-/// Read each camera's first `CameraInfo` and its pose in the world frame from TF.
+/// Each camera's first `CameraInfo` and its pose in the world frame from TF
+/// (`frames::rig::views`), in camera order.
 pub(crate) fn read_calibration(
     log: &SessionLog,
     p: &Params,
     t: &Topics,
-) -> anyhow::Result<Calibration> {
-    let file = log.path().display().to_string();
+) -> anyhow::Result<Vec<CalibratedView>> {
     let tf = TfBuffer::from_log(log, 0.0)?;
-    let mut views = Vec::new();
-    for (cam, topic) in p.cameras.iter().zip(&t.info) {
-        let (_, info) = read_topic::<CameraInfo>(log, topic)?
-            .next()
-            .with_context(|| format!("{file}: no CameraInfo on {topic}"))??;
-        let model = info
-            .model()
-            .with_context(|| format!("{file}: {topic}: camera {cam}"))?;
-        let frame = if info.header.frame_id.is_empty() {
-            cam.clone()
-        } else {
-            info.header.frame_id.clone()
-        };
-        let at = info.header.stamp.nanos().unwrap_or(Nanos(0));
-        let world_from_camera = tf.lookup(&p.world_frame, &frame, at).with_context(|| {
-            format!(
-                "{file}: no transform {} <- {frame} (camera {cam}) at {:.3} s",
-                p.world_frame,
-                at.0 as f64 * 1e-9
-            )
-        })?;
-        views.push(CalibratedView::new(model, world_from_camera));
-    }
-    Ok(Calibration { views })
+    let cameras: Vec<(String, String)> = p.cameras.iter().cloned().zip(t.info.clone()).collect();
+    Ok(rig::views(log, &tf, &cameras, &p.world_frame)?)
 }
 
 /// Each camera's centre and the heading of its optical axis on the ground.

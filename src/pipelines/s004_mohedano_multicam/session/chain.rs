@@ -6,7 +6,7 @@ use image::RgbImage;
 
 use super::super::{BackgroundUpdate, Params};
 use super::boxes::{box_head, boxes_from_detections, graph_params};
-use super::input::{Payload, decode_image};
+use super::input::Payload;
 use crate::geometry::triangulate::CalibratedView;
 use crate::track::cylinders::Object2d;
 use crate::track::graph_match::{Box2d, GraphTracker};
@@ -140,15 +140,14 @@ impl CameraChain {
                 out.present = true;
                 boxes_from_detections(&d, box_head(p, view))
             }
-            Some(img) => {
+            Some(Payload::Image(img)) => {
                 out.present = true;
-                match decode_image(&img) {
-                    Some(Ok(rgb)) => self.detect(&rgb, detector, &mut out),
-                    Some(Err(e)) => {
-                        out.failed = Some(e);
+                match img.decode() {
+                    Ok(rgb) => self.detect(&rgb, detector, &mut out),
+                    Err(e) => {
+                        out.failed = Some(e.to_string());
                         Vec::new()
                     }
-                    None => Vec::new(),
                 }
             }
         };

@@ -122,3 +122,83 @@ impl HeadCentroid<'_> {
         assoc
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::camera::{CameraModel, Pinhole};
+    use crate::geometry::look_at;
+    use crate::groundtruth::{CameraView, PersonTruth};
+
+    fn views() -> Vec<CalibratedView> {
+        [[0.2, 0.2, 2.8], [7.8, 0.2, 2.8]]
+            .iter()
+            .map(|c| {
+                CalibratedView::new(
+                    CameraModel::Pinhole(Pinhole::from_fov(352, 288, 78.0)),
+                    look_at(Point3::from(*c), Point3::new(4.0, 4.0, 0.9)),
+                )
+            })
+            .collect()
+    }
+
+    fn px(v: &CalibratedView, x: f64, y: f64, z: f64) -> [f64; 2] {
+        let p = v.project(&Point3::new(x, y, z)).expect("in view");
+        [p.x, p.y]
+    }
+
+    #[test]
+    fn exact_heads_triangulate_onto_the_person_and_shifted_centroids_off_by_the_shift() {
+        let views = views();
+        let cameras = vec!["cam_0".to_string(), "cam_1".to_string()];
+        // each camera: a box around the person, the projected head top, and a "centroid"
+        // that is the projection of a point 0.3 m beside the body centre
+        let mut per_camera = Vec::new();
+        let mut seen = Vec::new();
+        for (v, name) in views.iter().zip(&cameras) {
+            let head = px(v, 4.0, 4.0, 1.7);
+            let centroid = px(v, 4.3, 4.0, 0.9);
+            let foot = px(v, 4.0, 4.0, 0.0);
+            let bbox = [head[0] - 15.0, head[1], head[0] + 15.0, foot[1]];
+            per_camera.push(vec![(bbox, head, centroid)]);
+            seen.push(CameraView {
+                camera: name.clone(),
+                bbox: Some(bbox),
+                head_px: Some(head),
+                visibility: if name == "cam_0" { 0.5 } else { 1.0 },
+            });
+        }
+        let gt = PeopleFrame {
+            stamp_ns: 0,
+            people: vec![PersonTruth {
+                id: 3,
+                x: 4.0,
+                y: 4.0,
+                vx: 0.0,
+                vy: 0.0,
+                height: 1.7,
+                head_z: 1.6,
+                radius: 0.2,
+                legs: [[4.0, 3.9], [4.0, 4.1]],
+                leg_radius: 0.06,
+                cameras: seen,
+            }],
+        };
+        let hc = HeadCentroid {
+            cameras: &cameras,
+            views: &views,
+            occluded_visibility: 0.8,
+        };
+        let rows = hc.rows("templates", 12, &gt, &per_camera);
+        assert_eq!(rows.len(), 1);
+        let r = &rows[0];
+        assert_eq!((r.frame, r.id, r.cameras), (12, 3, 2));
+        // cam_0 sees half of the person and nobody else overlaps: static occlusion
+        assert!(r.occluded && !r.clear);
+        assert_eq!(r.min_visibility, 0.5);
+        assert!(r.head_error_m < 1e-6, "{r:?}");
+        assert!((r.centroid_error_m - 0.3).abs() < 1e-6, "{r:?}");
+        // one camera only: no triangulation, no row
+        assert!(hc.rows("templates", 12, &gt, &per_camera[..1]).is_empty());
+    }
+}

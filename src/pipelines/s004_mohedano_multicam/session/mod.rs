@@ -14,6 +14,7 @@ mod runs;
 mod truth;
 mod view;
 
+pub(crate) use boxes::MIN_BOX_HEIGHT_PX;
 pub(crate) use head_centroid::{ASSOCIATION_IOU, CLEAR_VISIBILITY};
 pub(crate) use truth::DETECTION_HEAD_TOL;
 pub(crate) use view::shapes_from_rows;
@@ -74,7 +75,7 @@ fn camera_chains(
     let file = s.log.path().display().to_string();
     let boot = if setup.use_images {
         bar.set_message("background bootstrap");
-        input::bootstrap_images(&s.log, &t.image, p.bootstrap_frames)?
+        crate::frames::camera::spread(&s.log, &t.image, p.bootstrap_frames)?
     } else {
         Vec::new()
     };
@@ -92,21 +93,22 @@ pub(crate) fn process(
     bar: &dyn Progress,
 ) -> anyhow::Result<SessionTables> {
     let log = &s.log;
-    let calib = read_calibration(log, p, t)?;
+    let views = read_calibration(log, p, t)?;
     let use_images = p.detector == Detector::Templates;
     let setup = ChainSetup::new(p, use_images)?;
     let mut chains = Chains {
-        chains: camera_chains(s, p, t, &calib.views, &setup, bar)?,
-        views: &calib.views,
+        chains: camera_chains(s, p, t, &views, &setup, bar)?,
+        views: &views,
         setup: &setup,
     };
     let pass = run_pass(log, p, t, &mut chains, bar)?;
     let frames = &pass.frames;
     let dt_s = frame_period(frames);
-    let tol_ns = ((p.sync_tolerance_s * 1e9) as u64).max(1);
+    let frame_tol = (p.sync_tolerance_s * 1e9) as u64;
+    let tol_ns = frame_tol.max(1);
     let gt_for_frame: Vec<Option<&PeopleFrame>> = frames
         .iter()
-        .map(|f| boxes::nearest_truth(&pass.truth, f.stamp, tol_ns))
+        .map(|f| pass.truth.nearest(f.stamp, tol_ns))
         .collect();
 
     // sources of 2-D objects for the 3-D stage
@@ -116,18 +118,18 @@ pub(crate) fn process(
     )];
     let mut gt_box = gt_boxes::GtBoxRun::default();
     if p.gt_boxes && !pass.truth.is_empty() {
-        gt_box = gt_boxes::gt_box_run(p, &calib.views, dt_s, &gt_for_frame);
+        gt_box = gt_boxes::gt_box_run(p, &views, dt_s, &gt_for_frame);
         sources.push((GT_BOXES, std::mem::take(&mut gt_box.objects)));
     }
     bar.set_message("3-D");
-    let runs = runs::run_all(p, &calib.views, dt_s, &sources, frames)?;
+    let runs = runs::run_all(p, &views, dt_s, &sources, frames)?;
     bar.inc(1);
 
     let scores = Scores {
         p,
         hc: head_centroid::HeadCentroid {
             cameras: &p.cameras,
-            views: &calib.views,
+            views: &views,
             occluded_visibility: p.occluded_visibility,
         },
         use_images,
@@ -136,7 +138,7 @@ pub(crate) fn process(
     let mut put = |name: &str, df: DataFrame| out.insert(name.to_string(), df);
     put(
         tables::CALIBRATION,
-        tables::CalibRow::frame(&calibration_rows(&p.cameras, &calib.views))?,
+        tables::CalibRow::frame(&calibration_rows(&p.cameras, &views))?,
     );
     put(tables::TRACKS, TrackRow::frame(&runs.tracks)?);
     put(tables::GT, GtRow::frame(&scores.gt(frames, &gt_for_frame))?);
@@ -167,7 +169,8 @@ pub(crate) fn process(
         })
         .collect();
     // a view that cannot be made is reported by the aggregation, not fatal
-    match view::camera_view(log, &t.image, &calib.views, &main, frames.len() as i64) {
+    let view = view::camera_view(log, &t.image, &views, &main, frames.len() as i64, frame_tol);
+    match view {
         Ok(Some(v)) => {
             let [frame, image, shapes] = view::view_tables(&v)?;
             put(tables::VIEW_FRAME, frame);

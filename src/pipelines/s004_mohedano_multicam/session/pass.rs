@@ -1,19 +1,20 @@
-//! The main pass over the log: camera messages grouped into frames by header stamp (within
-//! `sync_tolerance_s`; a camera's second message closes the frame), each frame through every
-//! camera's chain (cameras in parallel), and the ground truth collected on the way.
-
-use std::collections::BTreeMap;
+//! The main pass over the log: the cameras' messages grouped into frames by header stamp
+//! (`frames::multicam`: within `sync_tolerance_s`; a camera's second message closes the
+//! frame), each frame through every camera's chain (cameras in parallel); the ground truth
+//! (`frames::truth`).
 
 use anyhow::bail;
 use rayon::prelude::*;
 
 use super::super::{Params, Topics};
 use super::chain::{CameraChain, CameraOut, ChainSetup};
-use super::input::{Payload, image_payload, message_count, stamp_of};
+use super::input::{Payload, message_count};
+use crate::frames::multicam::{self, CameraPayload};
+use crate::frames::{ImageMsg, Skips, Stamped, truth};
 use crate::geometry::triangulate::CalibratedView;
 use crate::groundtruth::PeopleFrame;
+use crate::log::SessionLog;
 use crate::log::msgs::Detection2DArray;
-use crate::log::{Decoders, Message, SessionLog};
 use crate::pipelines::s004_mohedano_multicam::tables::CameraRow;
 use crate::progress::Progress;
 use crate::time::Nanos;
@@ -35,8 +36,8 @@ pub(crate) struct Pass {
     pub frames: Vec<FrameRec>,
     /// Per frame and camera (templates detector only).
     pub camera_rows: Vec<CameraRow>,
-    /// Ground-truth frames by stamp, sorted.
-    pub truth: Vec<(Nanos, PeopleFrame)>,
+    /// Ground-truth frames by stamp.
+    pub truth: Stamped<PeopleFrame>,
     pub bad_truth: usize,
     pub decode_failures: usize,
     pub missing_camera_frames: usize,
@@ -120,23 +121,27 @@ fn primary<'t>(log: &SessionLog, t: &'t Topics, use_images: bool) -> (&'t [Strin
     (primary, (total / expected as u64).max(1))
 }
 
-/// One camera message as a payload with its stamp.
-fn payload(
+/// Every frame of `topics` (one per camera) through the chains; the messages skipped.
+fn frames_of<P: CameraPayload>(
     log: &SessionLog,
-    decoders: &mut Decoders,
-    m: &Message,
-    use_images: bool,
-) -> Result<(Nanos, Payload), crate::log::LogError> {
-    if use_images {
-        image_payload(log, decoders, m)
-    } else {
-        decoders
-            .typed::<Detection2DArray>(log, m)
-            .map(|d| (stamp_of(m, d.header.stamp.nanos()), Payload::Detections(d)))
+    topics: &[String],
+    tol_ns: u64,
+    payload: fn(P) -> Payload,
+    run: &mut dyn FnMut(Nanos, Vec<Option<Payload>>),
+) -> anyhow::Result<Skips> {
+    let mut frames = multicam::group::<P>(log, topics, tol_ns)?;
+    for f in &mut frames {
+        let f = f?;
+        run(
+            f.stamp,
+            f.cameras.into_iter().map(|c| c.map(payload)).collect(),
+        );
     }
+    Ok(frames.into_skips())
 }
 
-/// Read the log once, in time order, and run the chains on every frame.
+/// Read the log's camera topics once, in time order, and run the chains on every frame; then
+/// the ground truth.
 pub(crate) fn run_pass(
     log: &SessionLog,
     p: &Params,
@@ -145,59 +150,25 @@ pub(crate) fn run_pass(
     bar: &dyn Progress,
 ) -> anyhow::Result<Pass> {
     let use_images = chains.setup.use_images;
-    let has_gt = log.summary().channel(&t.ground_truth).is_some();
     let (primary, length) = primary(log, t, use_images);
-    let role: BTreeMap<&str, usize> = primary
-        .iter()
-        .enumerate()
-        .map(|(c, tp)| (tp.as_str(), c))
-        .collect();
-    let mut topic_list: Vec<&str> = primary.iter().map(String::as_str).collect();
-    if has_gt {
-        topic_list.push(t.ground_truth.as_str());
-    }
     bar.set_length(length);
     bar.set_message("frames");
-
     let tol_ns = (p.sync_tolerance_s * 1e9) as u64;
-    let mut decoders = Decoders::new();
     let mut pass = Pass::default();
-    let mut pending: Vec<Option<Payload>> = (0..p.cameras.len()).map(|_| None).collect();
-    let mut pending_stamp: Option<Nanos> = None;
-    for m in log.messages_on(&topic_list)? {
-        let m = m?;
-        if m.topic() == t.ground_truth {
-            match serde_json::from_slice::<PeopleFrame>(&m.data) {
-                Ok(f) => pass.truth.push((Nanos(f.stamp_ns), f)),
-                Err(_) => pass.bad_truth += 1, // counted and reported, not fatal
-            }
-            continue;
-        }
-        let Some(&c) = role.get(m.topic()) else {
-            continue;
-        };
-        let (stamp, payload) = match payload(log, &mut decoders, &m, use_images) {
-            Ok(x) => x,
-            Err(e) => {
-                pass.failed(e.to_string());
-                continue;
-            }
-        };
-        if let Some(ps) = pending_stamp
-            && (stamp.0.abs_diff(ps.0) > tol_ns || pending[c].is_some())
-        {
-            let outs = chains.run(pending.iter_mut().map(Option::take).collect(), p);
-            pass.push_frame(ps, outs, p, use_images);
-            bar.inc(1);
-            pending_stamp = None;
-        }
-        pending_stamp.get_or_insert(stamp);
-        pending[c] = Some(payload);
-    }
-    if let Some(ps) = pending_stamp {
-        let outs = chains.run(pending.iter_mut().map(Option::take).collect(), p);
-        pass.push_frame(ps, outs, p, use_images);
-    }
+    let mut run = |stamp: Nanos, payloads: Vec<Option<Payload>>| {
+        let outs = chains.run(payloads, p);
+        pass.push_frame(stamp, outs, p, use_images);
+        bar.inc(1);
+    };
+    let skips = if use_images {
+        frames_of::<ImageMsg>(log, primary, tol_ns, Payload::Image, &mut run)?
+    } else {
+        frames_of::<Detection2DArray>(log, primary, tol_ns, Payload::Detections, &mut run)?
+    };
+    // messages that did not decode come first in the count; their first error wins
+    let chain_error = pass.first_error.take();
+    pass.decode_failures += skips.total() as usize;
+    pass.first_error = skips.first_error().map(str::to_string).or(chain_error);
     if pass.frames.is_empty() {
         bail!(
             "{}: no frames on {}",
@@ -205,6 +176,8 @@ pub(crate) fn run_pass(
             primary.join(", ")
         );
     }
-    pass.truth.sort_by_key(|x| x.0);
+    let (people, bad) = truth::people(log, &t.ground_truth)?;
+    pass.truth = people;
+    pass.bad_truth = bad.total() as usize;
     Ok(pass)
 }

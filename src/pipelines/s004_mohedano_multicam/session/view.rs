@@ -58,13 +58,14 @@ pub(crate) fn camera_view(
     views: &[CalibratedView],
     main: &[&TrackRow],
     frames: i64,
+    tol_ns: u64,
 ) -> anyhow::Result<Option<CameraView>> {
     let Some(frame) = view_frame(main, frames) else {
         return Ok(None);
     };
     let at: Vec<&TrackRow> = main.iter().copied().filter(|r| r.frame == frame).collect();
     let stamp = at.first().map_or(Nanos(0), |r| Nanos(r.stamp_ns as u64));
-    let images = images_at(log, image_topics, stamp)?;
+    let images = images_at(log, image_topics, stamp, tol_ns)?;
     let (w, h) = images
         .iter()
         .flatten()
