@@ -3,7 +3,9 @@
 //! `vision_msgs/msg/Detection2DArray` per camera, go through the "bring your own detector" path
 //! (`detector = "log"`) into the 3-D stage, which must reach MOTA ≥ 0.95; `--write-tracks`
 //! writes markers that read back through our reader; tables do not depend on the thread count;
-//! a log without one camera's calibration is skipped with a message naming the file and topic.
+//! a log without one camera's calibration is skipped with a message naming the file and topic;
+//! aggregation from the cached per-session tables alone, the logs moved away, gives the same
+//! tables and figures (the camera view included).
 //!
 //! The session is the first of the scenario's quick profile (one 12 s session; the quick profile
 //! has two) so that the debug build stays fast on a 2-core CI machine; the full quick dataset
@@ -358,4 +360,102 @@ fn a_log_without_one_cameras_calibration_is_skipped_with_file_and_topic() {
     assert!(text.contains("no_cam2_info"), "{text}");
     assert!(text.contains("/cam_2/camera_info"), "{text}");
     assert!(!text.contains("panicked"), "{text}");
+}
+
+/// The cached per-session tables of a run, read back as the runner does.
+fn cached_tables(out: &Path, dataset: &str, name: &str) -> peopletrack::run::SessionTables {
+    let dir = out
+        .join("s004_mohedano_multicam/sessions")
+        .join(dataset)
+        .join(name);
+    let mut t = peopletrack::run::SessionTables::new();
+    for e in std::fs::read_dir(&dir).expect("session cache") {
+        let p = e.expect("entry").path();
+        if p.extension().is_some_and(|x| x == "parquet") {
+            let stem = p.file_stem().expect("stem").to_string_lossy().into_owned();
+            t.insert(
+                stem,
+                peopletrack::report::table::read_parquet(&p).expect("parquet"),
+            );
+        }
+    }
+    t
+}
+
+#[test]
+fn aggregation_reads_only_the_cached_tables_and_gives_the_same_tables_and_figures() {
+    use peopletrack::pipelines::s004_mohedano_multicam::{MulticamCylinders, Params};
+    use peopletrack::run::{Aggregate, Experiment};
+    let f = fixture();
+    // a private copy of the log, run once through the CLI
+    let logs = f.root.join("absent/multicam_office");
+    std::fs::create_dir_all(&logs).expect("mkdir");
+    let good = glob::glob(&f.sessions)
+        .expect("glob")
+        .next()
+        .expect("one")
+        .expect("path");
+    let log = logs.join(good.file_name().expect("name"));
+    std::fs::copy(&good, &log).expect("copy");
+    let out = f.root.join("absent_out");
+    let o = run(f, &out, &format!("{}/*.mcap", logs.display()), &[], &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let name = log
+        .file_stem()
+        .expect("stem")
+        .to_string_lossy()
+        .into_owned();
+    let cached = cached_tables(&out, "multicam_office", &name);
+    // the camera view travels with the session's tables
+    for t in ["view_frame", "view_image", "view_shapes"] {
+        assert!(cached.contains_key(t), "{t}: {:?}", cached.keys());
+    }
+    // the logs move away; aggregation from the cache alone
+    std::fs::rename(&logs, f.root.join("absent/moved")).expect("move the logs away");
+    assert!(!log.exists());
+    let text = std::fs::read_to_string(&f.pipeline).expect("pipeline");
+    let params = peopletrack::run::config::parse::<Params>(&f.pipeline, &text)
+        .expect("parses")
+        .params;
+    let sessions = vec![(
+        peopletrack::run::config::SessionRef {
+            dataset: "multicam_office".into(),
+            name: name.clone(),
+            path: log.clone(),
+        },
+        cached,
+    )];
+    let products = MulticamCylinders::aggregate(
+        &Aggregate {
+            sessions: &sessions,
+            provenance: Default::default(),
+            write_tracks: None,
+        },
+        &params,
+    )
+    .expect("aggregates without the logs");
+    assert!(
+        !products.summary.iter().any(|l| l.contains("not drawn")),
+        "{:?}",
+        products.summary
+    );
+    // the same tables (CSV) and figures (PNG) as the run that had the logs
+    let dir = out.join("s004_mohedano_multicam");
+    assert!(products.tables.len() >= 6);
+    for t in &products.tables {
+        let before = std::fs::read(dir.join(format!("tables/{}.csv", t.name))).expect("csv");
+        assert_eq!(t.to_csv().expect("csv"), before, "table {}", t.name);
+    }
+    let figs = f.root.join("absent_figures");
+    let names: Vec<&str> = products.figures.iter().map(|x| x.name.as_str()).collect();
+    assert!(names.contains(&"camera_views"), "{names:?}");
+    for fig in &products.figures {
+        peopletrack::report::write_figure(&figs, fig, &f.root).expect("figure");
+        let png = format!("{}.png", fig.name);
+        assert_eq!(
+            std::fs::read(figs.join(&png)).expect("new"),
+            std::fs::read(dir.join("figures").join(&png)).expect("before"),
+            "figure {png}"
+        );
+    }
 }

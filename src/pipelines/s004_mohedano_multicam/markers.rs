@@ -1,4 +1,7 @@
-//! Tracks back into MCAP: a copy of each session log with one more topic,
+//! The `--write-tracks` export step (the only part of the aggregation that reads the input
+//! logs, so it needs them; it runs only when `--write-tracks` or the `write_tracks` parameter
+//! names a folder, never in plain aggregation): tracks back into MCAP, a copy of each session
+//! log with one more topic,
 //! `visualization_msgs/msg/MarkerArray` at every frame — a translucent cylinder per person
 //! (ground position, height, radius) and a text label with the track id, in the world frame.
 //! Foxglove's 3-D panel draws them with the scene, and its image panel projects them over the
@@ -8,16 +11,18 @@
 //! messages. Messages keep their log times; the markers are stamped and logged at the frame's
 //! header stamp and interleaved in time order with the copied messages.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use nalgebra::{Point3, Quaternion, Vector3};
 
 use super::Params;
-use super::evaluate::Scored;
+use super::scored::Scored;
+use super::tables::TrackRow;
 use crate::log::msgs::{Header, Marker, MarkerArray, Pose, Time};
 use crate::log::{ChannelId, SessionLog, SessionWriter, WriterOptions};
 use crate::report::figure::color;
+use crate::run::Aggregate;
 use crate::time::Nanos;
 
 /// Markers of one frame: `(stamp, [(id, x, y, height, radius, cameras)])`.
@@ -137,28 +142,42 @@ pub(crate) fn write_tracks(
     Ok(frames.len())
 }
 
-/// Write every session's tracks (main run) under `dir`.
-pub(super) fn write_all(s: &Scored, p: &Params, dir: &Path) -> anyhow::Result<Vec<String>> {
+/// The folder of the export: `--write-tracks`, else the `write_tracks` parameter; none: no
+/// export.
+pub(crate) fn export_dir(ctx: &Aggregate, p: &Params) -> Option<PathBuf> {
+    ctx.write_tracks
+        .map(Path::to_path_buf)
+        .or_else(|| (!p.write_tracks.is_empty()).then(|| PathBuf::from(&p.write_tracks)))
+}
+
+/// The markers of the main run of one session, one entry per frame with tracks.
+pub(crate) fn frame_tracks(rows: &[&TrackRow]) -> Vec<FrameTracks> {
+    let mut frames: Vec<FrameTracks> = Vec::new();
+    for r in rows {
+        let stamp = Nanos(r.stamp_ns as u64);
+        if frames.last().is_none_or(|f| f.0 != stamp) {
+            frames.push((stamp, Vec::new()));
+        }
+        if let Some(f) = frames.last_mut() {
+            f.1.push((r.id, r.x_m, r.y_m, r.height_m, r.radius_m, r.cameras));
+        }
+    }
+    frames
+}
+
+/// Write every session's tracks (main run) into copies of the logs under `dir` (reads the
+/// logs).
+pub(crate) fn export(s: &Scored, p: &Params, dir: &Path) -> anyhow::Result<Vec<String>> {
     let mut lines = Vec::new();
     for d in &s.data {
-        let t = &d.tracks;
-        let mut frames: Vec<FrameTracks> = Vec::new();
-        for i in t.rows(&s.main) {
-            let stamp = Nanos(t.stamp_ns[i] as u64);
-            if frames.last().is_none_or(|f| f.0 != stamp) {
-                frames.push((stamp, Vec::new()));
-            }
-            if let Some(f) = frames.last_mut() {
-                f.1.push((t.id[i], t.x[i], t.y[i], t.h[i], t.r[i], t.cameras[i]));
-            }
-        }
+        let frames = frame_tracks(&d.rows(&s.main));
         let out = dir.join(&d.dataset).join(format!("{}_tracks.mcap", d.name));
         let n = write_tracks(
             &d.path,
             &out,
             &p.tracks_topic,
             &p.world_frame,
-            2.0 * d.dt_s,
+            2.0 * d.session.dt_s,
             &frames,
         )
         .with_context(|| {

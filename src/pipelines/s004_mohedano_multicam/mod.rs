@@ -19,167 +19,36 @@
 //! tracks written back into a copy of each log as `visualization_msgs/msg/MarkerArray`
 //! (cylinders and labels in the world frame) that Foxglove's 3-D and image panels draw over
 //! the cameras.
+//!
+//! Layout, in the direction data flows: `params` (the pipeline file's `[params]` and their
+//! checks); `session` (per session: calibration and camera frames through `crate::frames`, each
+//! camera's chain, the ground-truth-box run, the 3-D runs, the per-frame scores and the camera
+//! view for the figure) writes the row structs of `tables`, the only thing cached; `scored`
+//! reads them back and evaluates every run once; `evaluate` (one file per sub-experiment) and
+//! `figures` turn them into tables and figures; `aggregate` orders the products; `markers` is
+//! the `--write-tracks` export, the one step of aggregation that reads the logs, run only when
+//! asked.
 
+mod aggregate;
 mod evaluate;
 mod figures;
 mod markers;
+mod params;
+mod scored;
 mod session;
+mod tables;
 
 use std::collections::BTreeMap;
 
 use crate::progress::Progress;
-use serde::{Deserialize, Serialize};
 
 use crate::groundtruth::PEOPLE_TOPIC;
 use crate::run::config::Invalid;
 use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
-use crate::track::cylinders::Selection;
+
+pub use params::{BackgroundUpdate, Detector, Params};
 
 pub struct MulticamCylinders;
-
-/// Where the 2-D objects of the main run come from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Detector {
-    /// The paper's chain: Gabor background, templates, graph-matching 2-D tracks.
-    Templates,
-    /// `vision_msgs/msg/Detection2DArray` per camera from the log, through the same 2-D
-    /// tracker (bring your own detector).
-    Log,
-}
-
-/// How the Gabor background learns (`vision::gabor::Update`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum BackgroundUpdate {
-    /// Eq. 2 as printed: every pixel with weight α.
-    All,
-    /// Our addition: foreground pixels (dilated by the Gabor filter radius) learn at
-    /// `foreground_alpha` instead of α, so walkers leave no trail.
-    Selective,
-}
-
-/// `[params]` of `pipelines/s004_mohedano_multicam.toml`; the file says where each default comes
-/// from.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// Camera names; topics default to `/<cam>/image_raw/compressed`, `/<cam>/camera_info`,
-    /// `/<cam>/detections` (remap with `[topics]` keys `<cam>_image`, `<cam>_info`,
-    /// `<cam>_detections`).
-    pub cameras: Vec<String>,
-    /// World frame of the TF tree (ground plane z = 0).
-    pub world_frame: String,
-    pub detector: Detector,
-    /// Also run the 3-D stage on the ground-truth boxes when the log has them.
-    pub gt_boxes: bool,
-    // §2 background
-    pub alpha: f64,
-    pub gabor_sigma_px: f64,
-    pub gabor_wavelength_px: f64,
-    pub mad_k: f64,
-    /// Frames, spread evenly over the log, whose per-pixel median starts the background
-    /// (0: the first frame, as eq. 2 alone would).
-    pub bootstrap_frames: usize,
-    pub background_update: BackgroundUpdate,
-    /// Learning rate of foreground pixels under `background_update = "selective"`.
-    pub foreground_alpha: f64,
-    // §3 detection
-    pub person_height_m: f64,
-    pub template_scales: usize,
-    pub template_tilts: usize,
-    pub template_threshold: f64,
-    /// Fraction of a template window the silhouette fills (a background margin is added
-    /// around it; 1 = the silhouette's tight box).
-    pub template_fill: f64,
-    /// Try at each head position only the template the calibration predicts there
-    /// (`vision::template::TemplateMap`); false: all templates everywhere.
-    pub templates_by_position: bool,
-    pub template_stride_px: u32,
-    pub nms_iou: f64,
-    pub nms_contained: f64,
-    /// Head point of a box (log detections, ground-truth boxes): the box's top row on the
-    /// image of the person's vertical (`track::cylinders::box_head_px`); false: the top centre.
-    pub box_head_on_axis: bool,
-    // §4 2-D tracking
-    pub match_iou_2d: f64,
-    pub max_missed_2d: u32,
-    // §5 3-D tracking
-    pub p_th_px: f64,
-    pub n_app: u32,
-    pub n_dis: u32,
-    pub selection: Selection,
-    pub head_height_m: [f64; 2],
-    pub room_m: [f64; 4],
-    pub room_margin_m: f64,
-    pub gate_m: f64,
-    pub max_combinations: usize,
-    // evaluation
-    /// CLEAR MOT / IDF1 matching thresholds on the ground (m).
-    pub match_m: Vec<f64>,
-    /// `N_app` values of the latency / false-alarm sweep (`N_dis = N_app`, as the paper).
-    pub n_app_sweep: Vec<u32>,
-    /// A camera's view of a person counts as statically occluded below this visibility when
-    /// no other person's box overlaps it.
-    pub occluded_visibility: f64,
-    /// Frames of different cameras within this time belong together (s).
-    pub sync_tolerance_s: f64,
-    /// Desks and other furniture drawn in the bird's-eye view `[x0, y0, x1, y1]` (m): the log
-    /// does not carry the room's furniture.
-    pub figure_obstacles_m: Vec<[f64; 4]>,
-    // outputs
-    /// Folder for the logs with tracks as markers (`<dir>/<dataset>/<session>_tracks.mcap`);
-    /// empty: do not write them.
-    pub write_tracks: String,
-    /// Topic of the markers in those logs.
-    pub tracks_topic: String,
-}
-
-impl Default for Params {
-    fn default() -> Self {
-        Params {
-            cameras: (0..4).map(|k| format!("cam_{k}")).collect(),
-            world_frame: "map".into(),
-            detector: Detector::Templates,
-            gt_boxes: true,
-            alpha: 0.02,
-            gabor_sigma_px: 2.0,
-            gabor_wavelength_px: 8.0,
-            mad_k: 3.0,
-            bootstrap_frames: 25,
-            background_update: BackgroundUpdate::Selective,
-            foreground_alpha: 0.0,
-            person_height_m: 1.75,
-            template_scales: 4,
-            template_tilts: 4,
-            template_threshold: 0.7,
-            template_fill: 0.5,
-            templates_by_position: true,
-            template_stride_px: 2,
-            nms_iou: 0.3,
-            nms_contained: 0.7,
-            box_head_on_axis: true,
-            match_iou_2d: 0.1,
-            max_missed_2d: 2,
-            p_th_px: 10.0,
-            n_app: 5,
-            n_dis: 5,
-            selection: Selection::Corrected,
-            head_height_m: [1.0, 2.3],
-            room_m: [0.0, 0.0, 8.0, 8.5],
-            room_margin_m: 0.5,
-            gate_m: 1.0,
-            max_combinations: 20_000,
-            match_m: vec![0.5, 1.0],
-            n_app_sweep: (1..=10).collect(),
-            occluded_visibility: 0.8,
-            sync_tolerance_s: 0.015,
-            figure_obstacles_m: Vec::new(),
-            write_tracks: String::new(),
-            tracks_topic: "/tracks/cylinders".into(),
-        }
-    }
-}
 
 /// Per-camera topics after `[topics]` remaps.
 #[derive(Debug, Clone)]
@@ -214,121 +83,11 @@ pub(crate) fn topics(p: &Params, remap: &BTreeMap<String, String>) -> Topics {
 
 impl Experiment for MulticamCylinders {
     const KIND: &'static str = "s004_mohedano_multicam";
-    const VERSION: u32 = 1;
+    const VERSION: u32 = 2;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {
-        let mut out: Vec<Invalid> = Vec::new();
-        let mut bad = |k: &str, r: String| out.push((k.to_string(), r));
-        if p.cameras.len() < 2 {
-            bad(
-                "cameras",
-                format!(
-                    "{} camera(s): triangulation needs at least 2",
-                    p.cameras.len()
-                ),
-            );
-        }
-        if !(p.alpha > 0.0 && p.alpha < 1.0) {
-            bad(
-                "alpha",
-                format!("{} is not in (0, 1) (paper: 0.01–0.1)", p.alpha),
-            );
-        }
-        if !(p.gabor_sigma_px >= 0.5 && p.gabor_sigma_px <= 20.0) {
-            bad(
-                "gabor_sigma_px",
-                format!("{} is not in [0.5, 20] px", p.gabor_sigma_px),
-            );
-        }
-        if !(p.gabor_wavelength_px >= 2.0 && p.gabor_wavelength_px.is_finite()) {
-            bad(
-                "gabor_wavelength_px",
-                format!("{} is below 2 px", p.gabor_wavelength_px),
-            );
-        }
-        if !(p.foreground_alpha >= 0.0 && p.foreground_alpha < 1.0) {
-            bad(
-                "foreground_alpha",
-                format!("{} is not in [0, 1)", p.foreground_alpha),
-            );
-        }
-        if !(p.mad_k >= 0.0 && p.mad_k.is_finite()) {
-            bad("mad_k", format!("{} is not a finite number ≥ 0", p.mad_k));
-        }
-        if !(p.template_threshold > 0.0 && p.template_threshold < 1.0) {
-            bad(
-                "template_threshold",
-                format!(
-                    "{} is not in (0, 1) (paper: 0.6–0.75)",
-                    p.template_threshold
-                ),
-            );
-        }
-        if !(p.template_fill > 0.0 && p.template_fill <= 1.0) {
-            bad(
-                "template_fill",
-                format!("{} is not a fraction in (0, 1]", p.template_fill),
-            );
-        }
-        if p.template_scales == 0
-            || p.template_tilts == 0
-            || p.template_scales * p.template_tilts > 64
-        {
-            bad(
-                "template_scales",
-                "scales × tilts must be between 1 and 64".into(),
-            );
-        }
-        if p.template_stride_px == 0 || p.template_stride_px > 16 {
-            bad(
-                "template_stride_px",
-                format!("{} is not in 1..=16", p.template_stride_px),
-            );
-        }
-        if !(p.person_height_m > 0.5 && p.person_height_m < 2.5) {
-            bad(
-                "person_height_m",
-                format!("{} is not a person's height in metres", p.person_height_m),
-            );
-        }
-        if !(p.p_th_px > 0.0 && p.p_th_px.is_finite()) {
-            bad(
-                "p_th_px",
-                format!("{} is not a positive number of pixels", p.p_th_px),
-            );
-        }
-        if p.n_app == 0 || p.n_dis == 0 {
-            bad("n_app", "N_app and N_dis must be at least 1 frame".into());
-        }
-        if p.n_app_sweep.contains(&0) {
-            bad("n_app_sweep", "values must be at least 1".into());
-        }
-        if p.match_m.is_empty() || p.match_m.iter().any(|&m| !(m > 0.0 && m.is_finite())) {
-            bad("match_m", "needs positive distances in metres".into());
-        }
-        if p.head_height_m[0].partial_cmp(&p.head_height_m[1]) != Some(std::cmp::Ordering::Less) {
-            bad("head_height_m", "the range is empty".into());
-        }
-        if !(p.room_m[0] < p.room_m[2] && p.room_m[1] < p.room_m[3]) {
-            bad(
-                "room_m",
-                "needs [x0, y0, x1, y1] with x0 < x1 and y0 < y1".into(),
-            );
-        }
-        if !(p.sync_tolerance_s > 0.0 && p.sync_tolerance_s < 1.0) {
-            bad(
-                "sync_tolerance_s",
-                format!("{} is not in (0, 1) s", p.sync_tolerance_s),
-            );
-        }
-        if !(0.0..=1.0).contains(&p.occluded_visibility) {
-            bad(
-                "occluded_visibility",
-                format!("{} is not in [0, 1]", p.occluded_visibility),
-            );
-        }
-        out
+        params::validate(p)
     }
 
     fn plan(p: &Params, remap: &BTreeMap<String, String>) -> Vec<Stage> {
@@ -373,7 +132,7 @@ impl Experiment for MulticamCylinders {
     }
 
     fn aggregate(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
-        evaluate::aggregate(ctx, p)
+        aggregate::aggregate(ctx, p)
     }
 }
 

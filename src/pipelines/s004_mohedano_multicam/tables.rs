@@ -1,0 +1,180 @@
+//! The per-session tables (cached as Parquet): one row struct each. `session` writes them,
+//! the aggregation (`scored`, `evaluate`, `figures`, `markers`) reads them back; nothing
+//! else passes between the two.
+
+use crate::table_row;
+
+/// Names of the cached per-session tables.
+pub(crate) const CALIBRATION: &str = "calibration";
+pub(crate) const TRACKS: &str = "tracks";
+pub(crate) const GT: &str = "gt";
+pub(crate) const HEAD_CENTROID: &str = "head_centroid";
+pub(crate) const CAMERAS: &str = "cameras";
+pub(crate) const DETECTIONS_2D: &str = "detections_2d";
+pub(crate) const VARIANTS: &str = "variants";
+pub(crate) const SESSION: &str = "session";
+/// The camera images at the frame the camera-view figure shows (`report::columns::image_table`).
+pub(crate) const VIEW_IMAGE: &str = "view_image";
+/// That frame and the cylinders projected into it.
+pub(crate) const VIEW_SHAPES: &str = "view_shapes";
+pub(crate) const VIEW_FRAME: &str = "view_frame";
+
+table_row! {
+    /// One 3-D track in one frame of one run (detector, selection rule, `N_app`).
+    #[derive(Debug, Clone, PartialEq)]
+    pub(crate) struct TrackRow {
+        pub detector: String,
+        pub selection: String,
+        pub n_app: i64,
+        pub frame: i64,
+        pub stamp_ns: i64,
+        pub t_s: f64,
+        pub id: i64,
+        pub x_m: f64,
+        pub y_m: f64,
+        pub vx_mps: f64,
+        pub vy_mps: f64,
+        pub height_m: f64,
+        pub radius_m: f64,
+        pub cameras: i64,
+        /// Supporting cameras as `camera:2-D id`, space separated.
+        pub support: String,
+        /// E_m of the supporting combination (none while the track coasts).
+        pub e_m_px: Option<f64>,
+        pub meas_x_m: Option<f64>,
+        pub meas_y_m: Option<f64>,
+        pub meas_height_m: Option<f64>,
+        pub meas_radius_m: Option<f64>,
+    }
+}
+
+table_row! {
+    /// One ground-truth person at one frame.
+    #[derive(Debug, Clone, PartialEq)]
+    pub(crate) struct GtRow {
+        pub frame: i64,
+        pub stamp_ns: i64,
+        pub t_s: f64,
+        pub id: i64,
+        pub x_m: f64,
+        pub y_m: f64,
+        pub height_m: f64,
+        pub radius_m: f64,
+        pub cameras_visible: i64,
+        pub in_room: bool,
+    }
+}
+
+table_row! {
+    /// Ground error of triangulating one person's head points and blob centroids at one frame.
+    #[derive(Debug, Clone, PartialEq)]
+    pub(crate) struct HeadCentroidRow {
+        pub detector: String,
+        pub frame: i64,
+        pub id: i64,
+        pub cameras: i64,
+        pub occluded: bool,
+        pub clear: bool,
+        pub min_visibility: f64,
+        pub head_error_m: f64,
+        pub centroid_error_m: f64,
+    }
+}
+
+table_row! {
+    /// Template detections of one camera at one frame against the visible ground-truth boxes;
+    /// head offsets and height ratios are sums over the matched pairs.
+    #[derive(Debug, Clone, PartialEq)]
+    pub(crate) struct Det2dRow {
+        pub frame: i64,
+        pub camera: String,
+        pub truth: i64,
+        pub detections: i64,
+        pub matched: i64,
+        pub head_dx_abs_px: f64,
+        pub head_dy_px: f64,
+        pub height_ratio: f64,
+    }
+}
+
+table_row! {
+    /// One camera's image stages at one frame (templates detector).
+    #[derive(Debug, Clone, PartialEq)]
+    pub(crate) struct CameraRow {
+        pub frame: i64,
+        pub camera: String,
+        pub threshold: f64,
+        pub foreground_frac: f64,
+        pub detections: i64,
+        pub objects_2d: i64,
+    }
+}
+
+table_row! {
+    /// The search statistics of one 3-D run.
+    #[derive(Debug, Clone, PartialEq)]
+    pub(crate) struct VariantRow {
+        pub detector: String,
+        pub selection: String,
+        pub n_app: i64,
+        pub combinations: i64,
+        pub pruned_frames: i64,
+        pub promoted: i64,
+        pub discarded: i64,
+    }
+}
+
+table_row! {
+    /// The session as a whole (one row).
+    #[derive(Debug, Clone, PartialEq)]
+    pub(crate) struct SessionRow {
+        pub frames: i64,
+        pub cameras: i64,
+        pub dt_s: f64,
+        pub duration_s: f64,
+        pub first_stamp_ns: i64,
+        pub decode_failures: i64,
+        pub missing_camera_frames: i64,
+        pub gt_frames: i64,
+        pub gt_bad_frames: i64,
+        pub first_error: String,
+    }
+}
+
+table_row! {
+    /// One camera's position and heading in the world frame.
+    #[derive(Debug, Clone, PartialEq)]
+    pub(crate) struct CalibRow {
+        pub camera: String,
+        pub x_m: f64,
+        pub y_m: f64,
+        pub z_m: f64,
+        pub heading_rad: f64,
+    }
+}
+
+table_row! {
+    /// The frame of the camera-view figure (one row), or why there is no view.
+    #[derive(Debug, Clone, PartialEq)]
+    pub(crate) struct ViewFrameRow {
+        pub frame: i64,
+        pub t_s: f64,
+        /// Empty, or why the view could not be made.
+        pub error: String,
+    }
+}
+
+table_row! {
+    /// One vertex of a shape drawn over the camera-view canvas: polyline vertices in order,
+    /// or the two corners of a labelled box.
+    #[derive(Debug, Clone, PartialEq)]
+    pub(crate) struct ViewShapeRow {
+        pub shape: i64,
+        /// "polyline" or "box".
+        pub kind: String,
+        pub color: i64,
+        pub label: String,
+        pub x: f64,
+        pub y: f64,
+    }
+}
