@@ -62,7 +62,7 @@ impl Experiment for BackgroundTracking {
     // 2: EM-like stop rule (settled boundary), ROC datasets can be excluded
     // 3: timing = fastest of 3 runs per frame; standing/walking person pixels; cached tables
     //    from row structs, images as PNG
-    const VERSION: u32 = 3;
+    const VERSION: u32 = 4;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

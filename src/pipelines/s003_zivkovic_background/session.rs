@@ -35,6 +35,9 @@ const ODOM_TOLERANCE_NS: u64 = 200_000_000;
 struct Context {
     ground_truth: Stamped<PeopleFrame>,
     bad_ground_truth: i64,
+    bad_odometry: i64,
+    /// The first undecodable odometry message's error, if any.
+    odometry_error: Option<String>,
     /// Odometry by stamp; empty for a camera that does not ride the robot.
     odometry: Stamped<Odometry>,
     camera_rides_robot: bool,
@@ -55,6 +58,8 @@ fn context(s: &Session, p: &Params, gt_topic: &str, odom_topic: &str) -> anyhow:
     Ok(Context {
         ground_truth,
         bad_ground_truth: gt_skips.count(gt_topic) as i64,
+        bad_odometry: odom.skips.count(odom_topic) as i64,
+        odometry_error: odom.skips.first_error().map(str::to_string),
         odometry: odom.samples,
         camera_rides_robot: rides,
     })
@@ -138,7 +143,11 @@ pub(super) fn process(
     let frames_without_mask = frames.frames_without_mask() as i64;
     let skips = frames.into_skips();
     let bad_images = skips.count(&tp.image) as i64;
-    let first_error = skips.first_error().unwrap_or_default().to_string();
+    let first_error = skips
+        .first_error()
+        .map(str::to_string)
+        .or_else(|| cx.odometry_error.clone())
+        .unwrap_or_default();
     if frame_index < 0 {
         anyhow::bail!(
             "{}: no decodable frame on {} ({bad_images} bad images; first error: {})",
@@ -160,6 +169,7 @@ pub(super) fn process(
         bad_masks: mask_topic.map_or(0, |m| skips.count(m) as i64),
         frames_without_mask,
         bad_ground_truth: cx.bad_ground_truth,
+        bad_odometry: cx.bad_odometry,
         first_error,
         camera_rides_robot: cx.camera_rides_robot,
         colour_frame0: colour.frame0(),
@@ -186,6 +196,7 @@ table_row! {
         bad_masks: i64,
         frames_without_mask: i64,
         bad_ground_truth: i64,
+        bad_odometry: i64,
         first_error: String,
     }
 }
@@ -200,13 +211,14 @@ pub(super) fn products(ctx: &Aggregate, products: &mut Products) -> anyhow::Resu
             continue;
         }
         let r = session_row(tables);
-        if r.bad_images + r.bad_masks + r.bad_ground_truth > 0 {
+        if r.bad_images + r.bad_masks + r.bad_ground_truth + r.bad_odometry > 0 {
             products.summary.push(format!(
-                "{}: skipped {} undecodable image(s), {} mask(s), {} ground-truth message(s); first: {}",
+                "{}: skipped {} undecodable image(s), {} mask(s), {} ground-truth message(s), {} odometry message(s); first: {}",
                 info.path.display(),
                 r.bad_images,
                 r.bad_masks,
                 r.bad_ground_truth,
+                r.bad_odometry,
                 if r.first_error.is_empty() { "(ground truth JSON)" } else { &r.first_error }
             ));
         }
@@ -218,6 +230,7 @@ pub(super) fn products(ctx: &Aggregate, products: &mut Products) -> anyhow::Resu
             bad_masks: r.bad_masks,
             frames_without_mask: r.frames_without_mask,
             bad_ground_truth: r.bad_ground_truth,
+            bad_odometry: r.bad_odometry,
             first_error: r.first_error,
         });
     }
@@ -227,7 +240,7 @@ pub(super) fn products(ctx: &Aggregate, products: &mut Products) -> anyhow::Resu
             "Sessions read: frames and the bad messages skipped (counted, never fatal)",
             SessionsRow::frame(&rows)?,
         )
-        .with_note("An image or mask message that does not decode is skipped and counted (as is an unreadable ground-truth message); first_error names the file, topic and log time of the first one. A log that cannot be read, or lacks the image topic, is skipped by the runner with its reason."),
+        .with_note("An image or mask message that does not decode is skipped and counted (as is an unreadable ground-truth or odometry message); first_error names the file, topic and log time of the first one. A log that cannot be read, or lacks the image topic, is skipped by the runner with its reason."),
     );
     Ok(())
 }

@@ -40,6 +40,7 @@ table_row! {
         pub bad_masks: i64,
         pub frames_without_mask: i64,
         pub bad_ground_truth: i64,
+        pub bad_odometry: i64,
         pub first_error: String,
         pub moving_frames: i64,
         pub camera_rides_robot: bool,
