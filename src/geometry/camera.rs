@@ -315,10 +315,11 @@ impl CameraModel {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn pinhole() -> Pinhole {
+    /// Test cameras, shared with `log::camera_info`'s tests.
+    pub(crate) fn pinhole() -> Pinhole {
         Pinhole {
             width: 352,
             height: 288,
@@ -330,7 +331,7 @@ mod tests {
         }
     }
 
-    fn para() -> Paracatadioptric {
+    pub(crate) fn para() -> Paracatadioptric {
         Paracatadioptric {
             width: 640,
             height: 480,
@@ -342,7 +343,7 @@ mod tests {
         }
     }
 
-    fn cone() -> ConicalMirror {
+    pub(crate) fn cone() -> ConicalMirror {
         ConicalMirror {
             width: 480,
             height: 480,

@@ -103,43 +103,7 @@ impl CameraInfo {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn pinhole() -> Pinhole {
-        Pinhole {
-            width: 352,
-            height: 288,
-            fx: 300.0,
-            fy: 302.0,
-            cx: 176.3,
-            cy: 143.9,
-            dist: [-0.2, 0.05, 0.001, -0.002, 0.0],
-        }
-    }
-
-    fn para() -> Paracatadioptric {
-        Paracatadioptric {
-            width: 640,
-            height: 480,
-            xc: 320.0,
-            yc: 240.0,
-            f: 110.0,
-            r_min: 20.0,
-            r_max: 230.0,
-        }
-    }
-
-    fn cone() -> ConicalMirror {
-        ConicalMirror {
-            width: 640,
-            height: 480,
-            xc: 320.0,
-            yc: 240.0,
-            f: 300.0,
-            d: 0.1,
-            alpha: 0.9,
-            z_top: 0.05,
-        }
-    }
+    use crate::geometry::camera::tests::{cone, para, pinhole};
 
     #[test]
     fn camera_info_round_trip() {
