@@ -3,7 +3,8 @@
 //! published: the `legs` detector + tracker scores MOTA exactly 1 on the scans after
 //! confirmation, the `nearest` baseline follows only the nearer person (MOTA exactly 0.5), a
 //! listed sequence without a log gets SKIPPED rows, and the tracks CSV is written. Then a
-//! structural run over the real `general_tracking_moving_1` (SKIPPED when absent).
+//! structural run over the real `general_tracking_moving_1` (SKIPPED when absent): it completes,
+//! has its rows, and places the annotations on the scans of the authors' `ground_truth.csv`.
 
 use std::path::{Path, PathBuf};
 
@@ -15,6 +16,8 @@ use peopletrack::groundtruth::{
 use peopletrack::log::msgs::{Header, LaserScan, TfMessage, Transform, TransformStamped};
 use peopletrack::log::{SessionWriter, WriterOptions};
 use peopletrack::pipelines::run_file;
+use peopletrack::report::columns::i64s;
+use peopletrack::report::table::read_parquet;
 use peopletrack::run::RunOptions;
 
 const BEAMS: usize = 721;
@@ -274,4 +277,24 @@ fn real_general_tracking_moving_1_completes() {
     // the other listed sequence was not asked for: SKIPPED
     let r = row(&rows, "person_following_outdoor_1", "legs");
     assert!(r["status"].starts_with("SKIPPED"));
+    // the annotations sit on the scans the authors' ground_truth.csv names
+    let cached = out.join(
+        "laser_people/sessions/general_tracking_moving_1/general_tracking_moving_1/truth.parquet",
+    );
+    let df = read_parquet(&cached).expect("cached truth");
+    let ours: Vec<(i64, i64)> = i64s(&df, "scan_idx")
+        .expect("scan_idx")
+        .into_iter()
+        .zip(i64s(&df, "id").expect("id"))
+        .collect();
+    let csv = std::fs::read_to_string(path.with_file_name("ground_truth.csv")).expect("csv");
+    let theirs: Vec<(i64, i64)> = csv
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[0].parse().expect("scan_idx"), f[2].parse().expect("id"))
+        })
+        .collect();
+    assert_eq!(ours, theirs);
 }

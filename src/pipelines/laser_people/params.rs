@@ -184,8 +184,10 @@ mod tests {
 
     #[test]
     fn bad_values_are_named() {
-        let mut p = Params::default();
-        p.match_m = f64::NAN;
+        let mut p = Params {
+            match_m: f64::NAN,
+            ..Params::default()
+        };
         p.synthetic.scans = Some([5, 2]);
         let keys: Vec<String> = validate(&p).into_iter().map(|(k, _)| k).collect();
         assert_eq!(keys, ["match_m", "synthetic"]);
