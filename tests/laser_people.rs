@@ -250,6 +250,73 @@ fn two_walkers_are_tracked_exactly() {
     assert!(out.join("laser_people/tables/paired_ttest.csv").exists());
 }
 
+/// Bad input: a session without its laser topic is a listed skip naming the topic; NaN, ±inf
+/// and zero ranges give no detections, and an undecodable scan is counted, not fatal.
+#[test]
+fn bad_scans_are_counted_and_a_missing_topic_is_a_named_skip() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = dir.path().join("bad");
+    std::fs::create_dir_all(&data).expect("mkdir");
+    let mut w = SessionWriter::create(&data.join("no_scan.mcap"), &WriterOptions::default())
+        .expect("create");
+    let gt = w
+        .add_json(PEOPLE_TOPIC, PEOPLE_SCHEMA, PEOPLE_JSON_SCHEMA)
+        .expect("gt");
+    let frame = PeopleFrame {
+        stamp_ns: 1_000_000_000,
+        people: vec![person(1, centre(0, 0))],
+    };
+    w.write_json(gt, Nanos(1_000_000_000), &frame).expect("gt");
+    w.finish().expect("finish");
+    let mut w = SessionWriter::create(&data.join("garbage.mcap"), &WriterOptions::default())
+        .expect("create");
+    let scan = w.add_ros2::<LaserScan>("/scan").expect("scan");
+    for i in 0..5u64 {
+        let t = Nanos(1_000_000_000 + i * 100_000_000);
+        let ranges = (0..BEAMS)
+            .map(|b| [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 0.0, -1.0][b % 5])
+            .collect();
+        let msg = LaserScan {
+            header: Header::new(t, "laser"),
+            angle_min: ANGLE_MIN as f32,
+            angle_increment: INCREMENT as f32,
+            range_min: 0.05,
+            range_max: 10.0,
+            ranges,
+            ..Default::default()
+        };
+        w.write(scan, t, &msg).expect("scan");
+    }
+    w.write_bytes(scan, Nanos(2_000_000_000), &[1, 2, 3])
+        .expect("garbage");
+    w.finish().expect("finish");
+
+    let toml = dir.path().join("laser_people.toml");
+    std::fs::write(&toml, PIPELINE).expect("write pipeline");
+    let out = dir.path().join("out");
+    let sessions = vec![format!("{}/*.mcap", data.display())];
+    let summary = run_file(&toml, &options(&out, sessions)).expect("runs");
+    assert_eq!(summary.skipped.len(), 1, "{:?}", summary.skipped);
+    assert!(
+        summary.skipped[0].0.ends_with("no_scan")
+            && summary.skipped[0].1.contains("missing laser topic /scan"),
+        "{:?}",
+        summary.skipped
+    );
+    let rows = csv_rows(&out.join("laser_people/tables/sessions.csv"));
+    let garbage = rows
+        .iter()
+        .find(|r| r["sequence"] == "garbage")
+        .expect("garbage row");
+    assert_eq!(
+        (&*garbage["scans"], &*garbage["skipped_messages"]),
+        ("5", "1")
+    );
+    let tracks =
+        std::fs::read_to_string(out.join("laser_people/tracks/garbage_legs.csv")).expect("tracks");
+    assert_eq!(tracks, "scan_idx,id,x,y,world_x,world_y\n");
+}
+
 /// The real wheelchair sequence (Leigh et al., ICRA 2015): the pipeline completes and the
 /// results table has its rows. No assertion on the numbers.
 #[test]
