@@ -257,7 +257,7 @@ fn bad_scans_are_counted_and_a_missing_topic_is_a_named_skip() {
     let dir = tempfile::tempdir().expect("tempdir");
     let data = dir.path().join("bad");
     std::fs::create_dir_all(&data).expect("mkdir");
-    let mut w = SessionWriter::create(&data.join("no_scan.mcap"), &WriterOptions::default())
+    let mut w = SessionWriter::create(data.join("no_scan.mcap"), &WriterOptions::default())
         .expect("create");
     let gt = w
         .add_json(PEOPLE_TOPIC, PEOPLE_SCHEMA, PEOPLE_JSON_SCHEMA)
@@ -268,7 +268,7 @@ fn bad_scans_are_counted_and_a_missing_topic_is_a_named_skip() {
     };
     w.write_json(gt, Nanos(1_000_000_000), &frame).expect("gt");
     w.finish().expect("finish");
-    let mut w = SessionWriter::create(&data.join("garbage.mcap"), &WriterOptions::default())
+    let mut w = SessionWriter::create(data.join("garbage.mcap"), &WriterOptions::default())
         .expect("create");
     let scan = w.add_ros2::<LaserScan>("/scan").expect("scan");
     for i in 0..5u64 {
