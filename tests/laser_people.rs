@@ -7,6 +7,7 @@
 //! has its rows, and places the annotations on the scans of the authors' `ground_truth.csv`.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use nalgebra::{Quaternion, Vector3};
 use peopletrack::Nanos;
@@ -14,7 +15,7 @@ use peopletrack::groundtruth::{
     PEOPLE_JSON_SCHEMA, PEOPLE_SCHEMA, PEOPLE_TOPIC, PeopleFrame, PersonTruth,
 };
 use peopletrack::log::msgs::{Header, LaserScan, TfMessage, Transform, TransformStamped};
-use peopletrack::log::{SessionWriter, WriterOptions};
+use peopletrack::log::{SessionWriter, Value, WriterOptions};
 use peopletrack::pipelines::run_file;
 use peopletrack::report::columns::i64s;
 use peopletrack::report::table::read_parquet;
@@ -74,14 +75,49 @@ fn person(id: u32, c: [f64; 2]) -> PersonTruth {
     }
 }
 
-/// The hand-made session: a static `map -> laser` identity, ten scans, ground truth per scan.
-fn write_log(path: &Path) {
+/// The `leg_tracker/msg/Person` definition of the real logs (no header; laser frame).
+const PERSON_DEF: &str = "geometry_msgs/Pose pose\nuint32 id\n================================================================================\nMSG: geometry_msgs/Pose\ngeometry_msgs/Point position\ngeometry_msgs/Quaternion orientation\n================================================================================\nMSG: geometry_msgs/Point\nfloat64 x\nfloat64 y\nfloat64 z\n================================================================================\nMSG: geometry_msgs/Quaternion\nfloat64 x\nfloat64 y\nfloat64 z\nfloat64 w\n";
+
+fn person_msg(id: u32, c: [f64; 2]) -> Value {
+    let f = |pairs: Vec<(&str, Value)>| {
+        Value::Struct(pairs.into_iter().map(|(k, v)| (Arc::from(k), v)).collect())
+    };
+    let position = f(vec![
+        ("x", Value::F64(c[0])),
+        ("y", Value::F64(c[1])),
+        ("z", Value::F64(0.0)),
+    ]);
+    let orientation = f(["x", "y", "z", "w"]
+        .into_iter()
+        .map(|k| (k, Value::F64(0.0)))
+        .collect());
+    f(vec![
+        (
+            "pose",
+            f(vec![("position", position), ("orientation", orientation)]),
+        ),
+        ("id", Value::U32(id)),
+    ])
+}
+
+/// The hand-made session: ten scans with ground truth per scan, either synthetic-style
+/// (`/ground_truth/people` in `map`, a static `map -> laser` identity) or as the real logs
+/// have it (`leg_tracker/msg/Person` in the laser frame, logged between a scan and the next,
+/// no TF).
+fn write_log(path: &Path, leigh_style: bool) {
     let mut w = SessionWriter::create(path, &WriterOptions::default()).expect("create");
     let tf = w.add_ros2::<TfMessage>("/tf_static").expect("tf");
     let scan = w.add_ros2::<LaserScan>("/scan").expect("scan");
     let gt = w
         .add_json(PEOPLE_TOPIC, PEOPLE_SCHEMA, PEOPLE_JSON_SCHEMA)
         .expect("gt");
+    let person_ch = w
+        .add_ros2_dynamic(
+            "/ground_truth_people_tracks",
+            "leg_tracker/msg/Person",
+            PERSON_DEF,
+        )
+        .expect("person");
     let identity = TransformStamped {
         header: Header::new(Nanos(500_000_000), "map"),
         child_frame_id: "laser".into(),
@@ -90,14 +126,16 @@ fn write_log(path: &Path) {
             rotation: Quaternion::new(1.0, 0.0, 0.0, 0.0),
         },
     };
-    w.write(
-        tf,
-        Nanos(500_000_000),
-        &TfMessage {
-            transforms: vec![identity],
-        },
-    )
-    .expect("tf");
+    if !leigh_style {
+        w.write(
+            tf,
+            Nanos(500_000_000),
+            &TfMessage {
+                transforms: vec![identity],
+            },
+        )
+        .expect("tf");
+    }
     for i in 0..SCANS {
         let t = Nanos(1_000_000_000 + i * 100_000_000);
         let circles: Vec<[f64; 2]> = (0..2).flat_map(|k| legs(centre(k, i))).collect();
@@ -115,11 +153,19 @@ fn write_log(path: &Path) {
             ..Default::default()
         };
         w.write(scan, t, &msg).expect("scan");
-        let frame = PeopleFrame {
-            stamp_ns: t.0,
-            people: vec![person(1, centre(0, i)), person(2, centre(1, i))],
-        };
-        w.write_json(gt, t, &frame).expect("gt");
+        if leigh_style {
+            for k in 0..2 {
+                let msg = person_msg(k as u32 + 1, centre(k, i));
+                w.write_value(person_ch, Nanos(t.0 + 50_000_000), &msg)
+                    .expect("person");
+            }
+        } else {
+            let frame = PeopleFrame {
+                stamp_ns: t.0,
+                people: vec![person(1, centre(0, i)), person(2, centre(1, i))],
+            };
+            w.write_json(gt, t, &frame).expect("gt");
+        }
     }
     w.finish().expect("finish");
 }
@@ -197,7 +243,7 @@ fn two_walkers_are_tracked_exactly() {
     let dir = tempfile::tempdir().expect("tempdir");
     let data = dir.path().join("walkers");
     std::fs::create_dir_all(&data).expect("mkdir");
-    write_log(&data.join("walkers_00.mcap"));
+    write_log(&data.join("walkers_00.mcap"), false);
     let toml = dir.path().join("laser_people.toml");
     std::fs::write(&toml, PIPELINE).expect("write pipeline");
     let out = dir.path().join("out");
@@ -248,6 +294,34 @@ fn two_walkers_are_tracked_exactly() {
     ids.dedup();
     assert_eq!(ids, ["1", "2"]);
     assert!(out.join("laser_people/tables/paired_ttest.csv").exists());
+}
+
+/// The real logs' ground-truth path on the same walkers: `leg_tracker/msg/Person` messages in
+/// the laser frame, each logged after its scan, a listed sequence with a scored-scan window, no
+/// TF (tracked in the laser frame): the same exact scores.
+#[test]
+fn leg_tracker_annotations_score_the_same() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = dir.path().join("leigh");
+    std::fs::create_dir_all(&data).expect("mkdir");
+    write_log(&data.join("leigh_walkers.mcap"), true);
+    let toml = dir.path().join("laser_people.toml");
+    let listed = "\n[[params.sequences]]\nname = \"leigh_walkers\"\nscan_topic = \"/scan\"\ngt_topic = \"/ground_truth_people_tracks\"\nscans = [2, 9]\nwedge_deg = [-90.0, 90.0]\n";
+    std::fs::write(&toml, format!("{PIPELINE}{listed}")).expect("write pipeline");
+    let out = dir.path().join("out");
+    let sessions = vec![format!("{}/*.mcap", data.display())];
+    let summary = run_file(&toml, &options(&out, sessions)).expect("runs");
+    assert!(summary.skipped.is_empty(), "{:?}", summary.skipped);
+    let rows = csv_rows(&out.join("laser_people/tables/results.csv"));
+    let legs = row(&rows, "leigh_walkers", "legs");
+    assert_eq!((&*legs["scored_scans"], &*legs["gt_count"]), ("8", "16"));
+    assert_eq!(legs["mota"].parse::<f64>().expect("mota"), 1.0);
+    let nearest = row(&rows, "leigh_walkers", "nearest");
+    assert_eq!(nearest["mota"].parse::<f64>().expect("mota"), 0.5);
+    let sessions = csv_rows(&out.join("laser_people/tables/sessions.csv"));
+    assert_eq!(sessions[0]["gt_kind"], "leg_tracker");
+    assert_eq!(sessions[0]["fixed_frame"], "laser");
+    assert_eq!(sessions[0]["gt_rows"], "20");
 }
 
 /// Bad input: a session without its laser topic is a listed skip naming the topic; NaN, ±inf
