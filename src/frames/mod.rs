@@ -14,6 +14,7 @@
 //! | images spread over the log | [`camera::spread`]`(log, &topics, n)?` | `Vec<Vec<RgbImage>>` per topic |
 //! | calibrated cameras | [`rig::camera`]`(log, &tf, name, info_topic, "map", at)?` / [`rig::views`] | [`RigCamera`] / `Vec<CalibratedView>` |
 //! | ground-truth people | [`truth::people`]`(log, PEOPLE_TOPIC)?` | ([`Stamped`]`<PeopleFrame>`, [`Skips`]) |
+//! | `leg_tracker/msg/Person` positions (real laser logs) | [`truth::person_positions`]`(log, topic)?` | (`Vec<`[`truth::PersonPosition`]`>`, [`Skips`]) |
 //! | nearest ground truth of a frame | `gt.nearest(stamp, tol_ns)` | `Option<&PeopleFrame>` |
 //! | odometry, camera on robot? | [`motion::odometry`]`(log, "/odom")?`, [`motion::camera_rides_robot`] | [`Motion`], `bool` |
 //! | laser scans with pose | [`laser::scans`]`(log, "/scan", &LaserOptions::default())?` | iterator of `Result<`[`LaserFrame`]`, LogError>` |

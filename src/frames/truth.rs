@@ -109,3 +109,76 @@ pub fn people(log: &SessionLog, topic: &str) -> Result<(Stamped<PeopleFrame>, Sk
 pub fn targets(log: &SessionLog, topic: &str) -> Result<(Stamped<TargetsFrame>, Skips), LogError> {
     read_json(log, topic, |f: &TargetsFrame| f.stamp_ns)
 }
+
+/// One person position of a `leg_tracker/msg/Person` message (Leigh et al.'s annotated
+/// benchmark logs: `geometry_msgs/Pose pose` + `uint32 id`, no header; the position is in the
+/// laser frame of the annotated scan). Decoded dynamically from the log's own schema.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PersonPosition {
+    /// The message's log time: the annotated scan is the last scan logged before it.
+    pub log_time: Nanos,
+    pub id: i64,
+    pub x: f64,
+    pub y: f64,
+}
+
+/// Every message of `topic` read as a [`PersonPosition`], in log order. A topic absent from
+/// the log gives no rows; a message without `pose.position.{x,y}` and `id`, or with a
+/// non-finite position, is skipped and counted.
+pub fn person_positions(
+    log: &SessionLog,
+    topic: &str,
+) -> Result<(Vec<PersonPosition>, Skips), LogError> {
+    let mut rows = Vec::new();
+    let mut skips = Skips::new();
+    if log.summary().channel(topic).is_none() {
+        return Ok((rows, skips));
+    }
+    let mut decoders = crate::log::Decoders::new();
+    for m in log.messages_on(&[topic])? {
+        let m = m?;
+        let value = match decoders.value(log, &m) {
+            Ok(v) => v,
+            Err(e) => {
+                skips.note(topic, e);
+                continue;
+            }
+        };
+        let read = || -> Result<(i64, f64, f64), crate::log::value::FieldError> {
+            let position = value.get("pose")?.get("position")?;
+            let id = value.get("id")?.as_i128()?;
+            let id = i64::try_from(id)
+                .map_err(|_| crate::log::value::FieldError::new("id out of range"))?;
+            Ok((
+                id,
+                position.get("x")?.as_f64()?,
+                position.get("y")?.as_f64()?,
+            ))
+        };
+        match read() {
+            Ok((id, x, y)) if x.is_finite() && y.is_finite() => rows.push(PersonPosition {
+                log_time: m.log_time,
+                id,
+                x,
+                y,
+            }),
+            Ok(_) => skips.note(
+                topic,
+                format!(
+                    "{}: topic {topic} at log time {} s: non-finite position",
+                    log.path().display(),
+                    m.log_time
+                ),
+            ),
+            Err(e) => skips.note(
+                topic,
+                format!(
+                    "{}: topic {topic} at log time {} s: {e}",
+                    log.path().display(),
+                    m.log_time
+                ),
+            ),
+        }
+    }
+    Ok((rows, skips))
+}

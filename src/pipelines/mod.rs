@@ -2,6 +2,7 @@
 //! its implementation.
 
 pub mod dataset_quality;
+pub mod laser_people;
 pub mod s000_cielniak_omni;
 pub mod s003_zivkovic_background;
 pub mod s004_mohedano_multicam;
@@ -32,6 +33,7 @@ macro_rules! registry {
 
 registry!(
     dataset_quality::DatasetQuality,
+    laser_people::LaserPeople,
     s000_cielniak_omni::OmniAppearance,
     s003_zivkovic_background::BackgroundTracking,
     s004_mohedano_multicam::MulticamCylinders,

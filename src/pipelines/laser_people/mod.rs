@@ -1,0 +1,75 @@
+//! `laser_people` — laser people detection and tracking ([`crate::laser`]) scored on real and
+//! synthetic laser logs.
+//!
+//! Per session ([`session`], cached as the rows of [`tables`]): every scan of the sequence's
+//! laser topic through two detectors, `legs` (seed 002 leg model → people → `PeopleTracker`)
+//! and `nearest` (the midpoint of the two legs nearest to the laser, no filter, one id), with
+//! the ground truth on its scans, all in the laser frame. The aggregation ([`aggregate`])
+//! scores each sequence × detector with CLEAR MOT, IDF1 and HOTA under the sequence's
+//! protocol ([`params::Sequence`]: scored scans, bearing wedge, range), runs a paired t-test
+//! of the two detectors' position errors, and writes the tracks as CSV. The real sequences
+//! (Leigh et al., ICRA 2015) are read in place from `../shared/real/laser/`; listed ones that
+//! are absent get SKIPPED rows.
+
+mod aggregate;
+mod params;
+mod session;
+mod tables;
+
+use std::collections::BTreeMap;
+
+use crate::progress::Progress;
+use crate::run::config::Invalid;
+use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
+
+pub use params::{Params, Sequence};
+
+pub struct LaserPeople;
+
+impl Experiment for LaserPeople {
+    const KIND: &'static str = "laser_people";
+    const VERSION: u32 = 1;
+    type Params = Params;
+
+    fn validate(p: &Params) -> Vec<Invalid> {
+        params::validate(p)
+    }
+
+    /// Topics differ per sequence, so none is required here: a session without its laser
+    /// topic fails in `process` with the topic named (a listed skip).
+    fn plan(p: &Params, _: &BTreeMap<String, String>) -> Vec<Stage> {
+        let mut scans: Vec<String> = p.sequences.iter().map(|s| s.scan_topic.clone()).collect();
+        scans.push(p.synthetic.scan_topic.clone());
+        scans.sort();
+        scans.dedup();
+        let mut gt: Vec<String> = p.sequences.iter().map(|s| s.gt_topic.clone()).collect();
+        gt.push(p.synthetic.gt_topic.clone());
+        gt.sort();
+        gt.dedup();
+        vec![
+            Stage {
+                name: "legs + tracker, nearest baseline".into(),
+                requires: vec![],
+                optional: [scans, vec!["/tf".into(), "/tf_static".into()]].concat(),
+            },
+            Stage {
+                name: "ground truth".into(),
+                requires: vec![],
+                optional: gt,
+            },
+        ]
+    }
+
+    fn process(
+        s: &Session,
+        p: &Params,
+        _: &BTreeMap<String, String>,
+        bar: &dyn Progress,
+    ) -> anyhow::Result<SessionTables> {
+        session::process(s, p, bar)
+    }
+
+    fn aggregate(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
+        aggregate::run(ctx, p)
+    }
+}

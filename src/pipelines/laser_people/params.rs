@@ -1,0 +1,195 @@
+//! `[params]` of `pipelines/laser_people.toml`: the scoring protocol of each sequence and its
+//! validation. The detector and tracker run at the defaults of [`crate::laser`] (chosen on
+//! synthetic data; nothing here tunes them).
+
+use serde::{Deserialize, Serialize};
+
+use crate::groundtruth::PEOPLE_TOPIC;
+use crate::run::config::Invalid;
+
+/// How one sequence (a session, by name) is read and scored.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sequence {
+    /// Session name (the log's file name without `.mcap`).
+    pub name: String,
+    pub scan_topic: String,
+    /// Ground truth: a `leg_tracker/msg/Person` topic (positions in the laser frame, each
+    /// belonging to the last scan logged before it) or a synthetic `/ground_truth/people` JSON
+    /// topic (map frame, joined to the scan by nearest stamp).
+    pub gt_topic: String,
+    /// First and last scored scan index (inclusive, 0-based in log order); absent: all.
+    #[serde(default)]
+    pub scans: Option<[i64; 2]>,
+    /// Ground truth and hypotheses are scored only when their bearing `atan2(y, x)` in the
+    /// laser frame lies in `[min, max]` degrees (both kept when equal to a bound, as the
+    /// authors' `clear_mot.py` removes only `angle < min` or `angle > max`).
+    #[serde(default)]
+    pub wedge_deg: Option<[f64; 2]>,
+    /// Ground truth and hypotheses farther than this from the laser are not scored (m).
+    #[serde(default)]
+    pub max_range_m: Option<f64>,
+}
+
+/// `[params]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Params {
+    /// CLEAR MOT / IDF1 match threshold and HOTA's half zero-similarity distance (m).
+    pub match_m: f64,
+    /// Largest stamp difference between a scan and the synthetic ground-truth frame joined to
+    /// it (s).
+    pub gt_tolerance_s: f64,
+    /// Confidence level of the paired t-test.
+    pub level: f64,
+    /// The real sequences, by session name; a listed sequence whose log is absent gets
+    /// SKIPPED rows.
+    pub sequences: Vec<Sequence>,
+    /// How every other session (the synthetic datasets) is read and scored (`name` unused).
+    pub synthetic: Sequence,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            match_m: 0.75,
+            gt_tolerance_s: 0.05,
+            level: 0.95,
+            sequences: Vec::new(),
+            synthetic: Sequence {
+                name: String::new(),
+                scan_topic: "/scan".into(),
+                gt_topic: PEOPLE_TOPIC.into(),
+                scans: None,
+                wedge_deg: None,
+                max_range_m: None,
+            },
+        }
+    }
+}
+
+impl Params {
+    /// The protocol of session `name`: its listed sequence, else the synthetic one.
+    pub fn sequence(&self, name: &str) -> &Sequence {
+        self.sequences
+            .iter()
+            .find(|s| s.name == name)
+            .unwrap_or(&self.synthetic)
+    }
+
+    /// Whether `name` is one of the listed (real) sequences.
+    pub fn is_listed(&self, name: &str) -> bool {
+        self.sequences.iter().any(|s| s.name == name)
+    }
+}
+
+impl Sequence {
+    /// Whether scan `idx` is scored.
+    pub fn scores_scan(&self, idx: i64) -> bool {
+        self.scans.is_none_or(|[a, b]| idx >= a && idx <= b)
+    }
+
+    /// Whether a position in the laser frame is scored (wedge and range).
+    pub fn scores_point(&self, x: f64, y: f64) -> bool {
+        if !(x.is_finite() && y.is_finite()) {
+            return false;
+        }
+        let in_wedge = self.wedge_deg.is_none_or(|[lo, hi]| {
+            let a = y.atan2(x);
+            !(a < lo.to_radians() || a > hi.to_radians())
+        });
+        let in_range = self.max_range_m.is_none_or(|r| x.hypot(y) <= r);
+        in_wedge && in_range
+    }
+}
+
+fn check_sequence(key: &str, s: &Sequence, out: &mut Vec<Invalid>) {
+    if s.scan_topic.is_empty() || s.gt_topic.is_empty() {
+        out.push((key.into(), "scan_topic and gt_topic must be set".into()));
+    }
+    if let Some([a, b]) = s.scans
+        && !(a >= 0 && a <= b)
+    {
+        out.push((
+            key.into(),
+            format!("scans [{a}, {b}] needs 0 ≤ first ≤ last"),
+        ));
+    }
+    if let Some([lo, hi]) = s.wedge_deg
+        && !(lo.is_finite() && hi.is_finite() && lo <= hi)
+    {
+        out.push((
+            key.into(),
+            format!("wedge_deg [{lo}, {hi}] needs min ≤ max"),
+        ));
+    }
+    if let Some(r) = s.max_range_m
+        && !(r.is_finite() && r > 0.0)
+    {
+        out.push((
+            key.into(),
+            format!("max_range_m {r} must be finite and > 0"),
+        ));
+    }
+}
+
+pub(super) fn validate(p: &Params) -> Vec<Invalid> {
+    let mut out = Vec::new();
+    if !(p.match_m.is_finite() && p.match_m > 0.0) {
+        out.push((
+            "match_m".into(),
+            format!("{} must be finite and > 0", p.match_m),
+        ));
+    }
+    if !(p.gt_tolerance_s.is_finite() && p.gt_tolerance_s >= 0.0 && p.gt_tolerance_s <= 10.0) {
+        out.push((
+            "gt_tolerance_s".into(),
+            format!("{} is not in [0, 10] s", p.gt_tolerance_s),
+        ));
+    }
+    if !(p.level > 0.0 && p.level < 1.0) {
+        out.push(("level".into(), format!("{} is not in (0, 1)", p.level)));
+    }
+    for s in &p.sequences {
+        if s.name.is_empty() {
+            out.push(("sequences".into(), "every sequence needs a name".into()));
+        }
+        check_sequence("sequences", s, &mut out);
+    }
+    check_sequence("synthetic", &p.synthetic, &mut out);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_wedge_keeps_its_bounds_and_drops_what_lies_outside() {
+        let s = Sequence {
+            wedge_deg: Some([-80.0, 12.0]),
+            max_range_m: Some(5.0),
+            scans: Some([133, 404]),
+            ..Params::default().synthetic
+        };
+        assert!(s.scores_point(1.0, 0.0));
+        assert!(s.scores_point(0.2, -1.0)); // −78.7°
+        assert!(!s.scores_point(0.1, -1.0)); // −84.3°
+        assert!(!s.scores_point(1.0, 0.25)); // 14.0°
+        assert!(!s.scores_point(6.0, 0.0)); // beyond 5 m
+        assert!(!s.scores_point(f64::NAN, 0.0));
+        assert!(s.scores_scan(133) && s.scores_scan(404));
+        assert!(!s.scores_scan(132) && !s.scores_scan(405));
+    }
+
+    #[test]
+    fn bad_values_are_named() {
+        let mut p = Params {
+            match_m: f64::NAN,
+            ..Params::default()
+        };
+        p.synthetic.scans = Some([5, 2]);
+        let keys: Vec<String> = validate(&p).into_iter().map(|(k, _)| k).collect();
+        assert_eq!(keys, ["match_m", "synthetic"]);
+    }
+}

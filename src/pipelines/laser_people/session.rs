@@ -1,0 +1,347 @@
+//! The per-session stage: every scan of the sequence's laser topic through the leg model of
+//! [`crate::laser`] and both detectors, the ground truth placed on its scans, all in the laser
+//! frame; the rows of [`super::tables`].
+//!
+//! - **Scans** come from [`frames::laser::scans`] with the sensor pose at the scan stamp in the
+//!   fixed frame (`odom` when TF has it; the synthetic logs' `map`, their ground truth's frame;
+//!   the sensor frame without TF). Scan indices count the decoded scans in log order.
+//! - **`legs`**: jump-distance segments → seed 002 leg model → leg pairs (people) and single
+//!   legs in the fixed frame → [`PeopleTracker`]; its confirmed tracks after each scan, put
+//!   back into the laser frame through the inverse pose.
+//! - **`nearest`**: the baseline without a filter: the midpoint of the two legs nearest to the
+//!   laser (any distance apart), one hypothesis with id 1 on each scan with two legs or more.
+//! - **Ground truth**: `leg_tracker/msg/Person` messages (real logs) are already in the laser
+//!   frame and belong to the last scan logged before them (the README's and `clear_mot.py`'s
+//!   rule); synthetic `/ground_truth/people` frames (map frame) are joined to a scan by nearest
+//!   stamp and put into the laser frame through the inverse of the scan's `map` pose.
+
+use nalgebra::{Isometry3, Point2, Point3};
+
+use super::params::{Params, Sequence};
+use super::tables::{self, ScanRow, SessionRow, TrackRow, TruthRow};
+use crate::frames::laser::{self as laser_frames, LaserFrame, LaserOptions};
+use crate::frames::{Skips, truth};
+use crate::laser::legs::{self, Detections, LegParams};
+use crate::laser::points::{self, ScanGeometry};
+use crate::laser::segment::{self, SegmentOptions};
+use crate::laser::tracker::{PeopleTracker, TrackerParams};
+use crate::log::SessionLog;
+use crate::log::decode::carries;
+use crate::progress::Progress;
+use crate::report::rows::Rows;
+use crate::run::{Session, SessionTables};
+use crate::time::Nanos;
+
+/// The ROS 2 type of the real logs' annotations.
+pub const PERSON_TYPE: &str = "leg_tracker/msg/Person";
+
+/// Where a session's ground truth comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum GtKind {
+    LegTracker,
+    Synthetic,
+    None,
+}
+
+impl GtKind {
+    fn of(log: &SessionLog, topic: &str) -> GtKind {
+        match log.summary().channel(topic) {
+            None => GtKind::None,
+            Some(ch) if carries(ch, PERSON_TYPE) => GtKind::LegTracker,
+            Some(_) => GtKind::Synthetic,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            GtKind::LegTracker => "leg_tracker",
+            GtKind::Synthetic => "synthetic",
+            GtKind::None => "none",
+        }
+    }
+}
+
+/// Everything the scan loop collects.
+#[derive(Default)]
+struct Collected {
+    scans: Vec<ScanRow>,
+    truth: Vec<TruthRow>,
+    tracks: Vec<TrackRow>,
+    gt_dropped: i64,
+}
+
+/// A fixed-frame point in the laser frame (identity without a pose).
+fn to_laser(pose: Option<&Isometry3<f64>>, p: Point2<f64>) -> Point2<f64> {
+    match pose {
+        Some(pose) => {
+            let q = pose.inverse_transform_point(&Point3::new(p.x, p.y, 0.0));
+            Point2::new(q.x, q.y)
+        }
+        None => p,
+    }
+}
+
+/// The leg model on one scan.
+fn detect(f: &LaserFrame) -> Detections {
+    let g = ScanGeometry {
+        angle_min: f64::from(f.scan.angle_min),
+        angle_increment: f64::from(f.scan.angle_increment),
+        range_min: f64::from(f.scan.range_min),
+        range_max: f64::from(f.scan.range_max),
+    };
+    let pts = points::project(&f.scan.ranges, &g, f.pose.as_ref());
+    let segs = segment::segment(&pts, &SegmentOptions::default());
+    legs::detect(
+        &pts,
+        &segs,
+        f.scan.ranges.len(),
+        f.pose.as_ref(),
+        &LegParams::default(),
+    )
+}
+
+/// The `nearest` baseline: the midpoint of the two legs nearest to the laser, as
+/// `(laser frame, fixed frame)`; ties by leg order.
+pub fn nearest_pair(d: &Detections) -> Option<(Point2<f64>, Point2<f64>)> {
+    let mut order: Vec<usize> = (0..d.legs.len()).collect();
+    order.sort_by(|&a, &b| {
+        let (ra, rb) = (
+            d.legs[a].sensor.coords.norm(),
+            d.legs[b].sensor.coords.norm(),
+        );
+        ra.total_cmp(&rb).then(a.cmp(&b))
+    });
+    let (a, b) = (&d.legs[*order.first()?], &d.legs[*order.get(1)?]);
+    Some((
+        nalgebra::center(&a.sensor, &b.sensor),
+        nalgebra::center(&a.fixed, &b.fixed),
+    ))
+}
+
+fn track_row(
+    detector: &str,
+    idx: i64,
+    id: i64,
+    laser: Point2<f64>,
+    world: Point2<f64>,
+) -> TrackRow {
+    TrackRow {
+        detector: detector.into(),
+        scan_idx: idx,
+        id,
+        x: laser.x,
+        y: laser.y,
+        world_x: world.x,
+        world_y: world.y,
+    }
+}
+
+/// One scan through both detectors (and the synthetic ground truth, when given).
+fn scan_step(
+    f: &LaserFrame,
+    idx: i64,
+    time_s: f64,
+    tracker: &mut PeopleTracker,
+    gt: Option<&crate::groundtruth::PeopleFrame>,
+    out: &mut Collected,
+) {
+    let d = detect(f);
+    let people: Vec<Point2<f64>> = d.people.iter().map(|p| p.fixed).collect();
+    let single: Vec<Point2<f64>> = d.single_legs.iter().map(|&i| d.legs[i].fixed).collect();
+    tracker.step(time_s, &people, &single);
+    let pose = f.pose.as_ref();
+    for t in tracker.confirmed() {
+        let world = t.position();
+        let id = i64::try_from(t.id).unwrap_or(i64::MAX);
+        out.tracks
+            .push(track_row("legs", idx, id, to_laser(pose, world), world));
+    }
+    if let Some((laser, world)) = nearest_pair(&d) {
+        out.tracks.push(track_row("nearest", idx, 1, laser, world));
+    }
+    if let Some(frame) = gt {
+        for person in &frame.people {
+            match pose {
+                Some(_) => {
+                    let p = to_laser(pose, Point2::new(person.x, person.y));
+                    out.truth.push(TruthRow {
+                        scan_idx: idx,
+                        id: i64::from(person.id),
+                        x: p.x,
+                        y: p.y,
+                    });
+                }
+                None => out.gt_dropped += 1,
+            }
+        }
+    }
+    out.scans.push(ScanRow {
+        scan_idx: idx,
+        stamp_ns: i64::try_from(f.stamp.0).unwrap_or(i64::MAX),
+        log_time_ns: i64::try_from(f.log_time.0).unwrap_or(i64::MAX),
+        posed: f.pose.is_some(),
+        legs: d.legs.len() as i64,
+        people: d.people.len() as i64,
+    });
+}
+
+/// Real annotations onto their scans: each belongs to the last scan logged before it.
+fn place_leg_tracker(rows: &[truth::PersonPosition], out: &mut Collected) {
+    let times: Vec<i64> = out.scans.iter().map(|s| s.log_time_ns).collect();
+    let mut seen = std::collections::BTreeSet::new();
+    for r in rows {
+        let t = i64::try_from(r.log_time.0).unwrap_or(i64::MAX);
+        let after = times.partition_point(|&s| s < t);
+        let Some(k) = after.checked_sub(1) else {
+            out.gt_dropped += 1;
+            continue;
+        };
+        let idx = out.scans[k].scan_idx;
+        if !seen.insert((idx, r.id)) {
+            out.gt_dropped += 1;
+            continue;
+        }
+        out.truth.push(TruthRow {
+            scan_idx: idx,
+            id: r.id,
+            x: r.x,
+            y: r.y,
+        });
+    }
+    out.truth.sort_by_key(|r| r.scan_idx); // stable: annotation order within a scan
+}
+
+/// Process one session (see the module doc).
+pub(super) fn process(
+    s: &Session,
+    p: &Params,
+    bar: &dyn Progress,
+) -> anyhow::Result<SessionTables> {
+    let seq: &Sequence = p.sequence(&s.info.name);
+    let log = &s.log;
+    if log.summary().channel(&seq.scan_topic).is_none() {
+        anyhow::bail!(
+            "{}: missing laser topic {}",
+            log.path().display(),
+            seq.scan_topic
+        );
+    }
+    let kind = GtKind::of(log, &seq.gt_topic);
+    let mut skips = Skips::new();
+    let (synthetic, gt_skips) = match kind {
+        GtKind::Synthetic => truth::people(log, &seq.gt_topic)?,
+        _ => (crate::frames::Stamped::default(), Skips::new()),
+    };
+    skips.merge(gt_skips);
+    let options = LaserOptions {
+        fixed_frame: (kind == GtKind::Synthetic).then(|| "map".to_string()),
+        ..LaserOptions::default()
+    };
+    let tolerance_ns = (p.gt_tolerance_s * 1e9).round() as u64;
+    let mut frames = laser_frames::scans(log, &seq.scan_topic, &options)?;
+    let summary = log.summary();
+    let expected = summary
+        .channel(&seq.scan_topic)
+        .zip(summary.statistics.as_ref())
+        .and_then(|(c, st)| st.channel_message_counts.get(&c.id).copied());
+    bar.set_length(expected.unwrap_or(0));
+    let mut tracker = PeopleTracker::new(TrackerParams::default());
+    let mut out = Collected::default();
+    let mut first: Option<Nanos> = None;
+    for (idx, f) in frames.by_ref().enumerate() {
+        let f = f?;
+        let t0 = *first.get_or_insert(f.stamp);
+        let time_s = f.stamp.signed_sub(t0) as f64 * 1e-9;
+        let gt = (kind == GtKind::Synthetic)
+            .then(|| synthetic.nearest(f.stamp, tolerance_ns))
+            .flatten();
+        scan_step(&f, idx as i64, time_s, &mut tracker, gt, &mut out);
+        bar.inc(1);
+    }
+    let fixed_frame = frames.fixed_frame().unwrap_or_default().to_string();
+    let unposed = frames.unposed() as i64;
+    skips.merge(frames.skips().clone());
+    if kind == GtKind::LegTracker {
+        let (rows, gt_skips) = truth::person_positions(log, &seq.gt_topic)?;
+        skips.merge(gt_skips);
+        place_leg_tracker(&rows, &mut out);
+    }
+    let session = SessionRow {
+        scan_topic: seq.scan_topic.clone(),
+        gt_topic: seq.gt_topic.clone(),
+        gt_kind: kind.name().into(),
+        fixed_frame,
+        scans: out.scans.len() as i64,
+        unposed,
+        gt_rows: out.truth.len() as i64,
+        gt_dropped: out.gt_dropped,
+        skipped_messages: i64::try_from(skips.total()).unwrap_or(i64::MAX),
+        first_error: skips.first_error().map(str::to_string),
+    };
+    Ok(SessionTables::from([
+        (tables::SESSION.to_string(), SessionRow::frame(&[session])?),
+        (tables::SCANS.to_string(), ScanRow::frame(&out.scans)?),
+        (tables::TRUTH.to_string(), TruthRow::frame(&out.truth)?),
+        (tables::TRACKS.to_string(), TrackRow::frame(&out.tracks)?),
+    ]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scan(scan_idx: i64, log_ms: i64) -> ScanRow {
+        ScanRow {
+            scan_idx,
+            stamp_ns: 0,
+            log_time_ns: log_ms * 1_000_000,
+            posed: true,
+            legs: 0,
+            people: 0,
+        }
+    }
+
+    /// The README's rule: an annotation belongs to the last scan logged strictly before it;
+    /// one before the first scan, or a second position of an id on one scan, is dropped.
+    #[test]
+    fn annotations_belong_to_the_last_scan_logged_before_them() {
+        let mut out = Collected {
+            scans: vec![scan(0, 100), scan(1, 200), scan(2, 300)],
+            ..Collected::default()
+        };
+        let at = |ms: u64, id: i64| truth::PersonPosition {
+            log_time: Nanos(ms * 1_000_000),
+            id,
+            x: 1.0,
+            y: f64::from(u32::try_from(ms).unwrap_or(0)),
+        };
+        let rows = [
+            at(50, 1),
+            at(150, 1),
+            at(200, 2),
+            at(250, 2),
+            at(260, 2),
+            at(350, 1),
+        ];
+        place_leg_tracker(&rows, &mut out);
+        let got: Vec<(i64, i64, f64)> = out.truth.iter().map(|r| (r.scan_idx, r.id, r.y)).collect();
+        assert_eq!(
+            got,
+            vec![(0, 1, 150.0), (0, 2, 200.0), (1, 2, 250.0), (2, 1, 350.0)]
+        );
+        assert_eq!(out.gt_dropped, 2);
+    }
+
+    #[test]
+    fn positions_go_back_into_the_laser_frame() {
+        use nalgebra::{Translation3, UnitQuaternion};
+        let pose = Isometry3::from_parts(
+            Translation3::new(1.0, 2.0, 0.0),
+            UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2),
+        );
+        // the laser's x axis points along the fixed frame's y axis
+        let p = to_laser(Some(&pose), Point2::new(1.0, 5.0));
+        assert!((p - Point2::new(3.0, 0.0)).norm() < 1e-12, "{p}");
+        assert_eq!(to_laser(None, Point2::new(1.0, 5.0)), Point2::new(1.0, 5.0));
+    }
+}
