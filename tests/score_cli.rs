@@ -133,3 +133,45 @@ fn needs_exactly_one_matching_rule() {
         assert_eq!(out.status.code(), Some(2), "{extra:?}");
     }
 }
+
+#[test]
+fn an_empty_ground_truth_or_a_bad_threshold_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let gt = dir.path().join("gt.csv");
+    let hyp = dir.path().join("hyp.csv");
+    std::fs::write(&gt, "").expect("write");
+    std::fs::write(&hyp, "1,1,0,0,10,10,1,-1,-1,-1\n").expect("write");
+    let out = peopletrack()
+        .args(["score", "--iou", "0.5", "--gt"])
+        .arg(&gt)
+        .arg("--hyp")
+        .arg(&hyp)
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("gt.csv") && err.contains("no ground-truth rows"),
+        "{err}"
+    );
+    for (flag, value, says) in [
+        ("--dist-m", "-1", "positive number of metres"),
+        ("--dist-m", "0", "positive number of metres"),
+        ("--iou", "1.5", "(0, 1]"),
+        ("--iou", "-0.2", "(0, 1]"),
+    ] {
+        let out = peopletrack()
+            .args(["score", flag, value, "--gt"])
+            .arg(&hyp)
+            .arg("--hyp")
+            .arg(&hyp)
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{flag} {value}: {err}");
+        assert!(
+            err.contains(says) && err.contains(value),
+            "{flag} {value}: {err}"
+        );
+    }
+}

@@ -43,10 +43,10 @@ pub struct Args {
     #[arg(long, value_name = "HYP.csv")]
     pub hyp: PathBuf,
     /// Match boxes: a pair may match when IoU ≥ MIN_IOU (MOTChallenge uses 0.5).
-    #[arg(long, value_name = "MIN_IOU")]
+    #[arg(long, value_name = "MIN_IOU", allow_negative_numbers = true)]
     pub iou: Option<f64>,
     /// Match ground-plane points (columns x,y in metres): a pair may match within METRES.
-    #[arg(long, value_name = "METRES")]
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     pub dist_m: Option<f64>,
     /// Print every metric (per-α HOTA included) as one JSON object.
     #[arg(long)]
@@ -59,7 +59,24 @@ pub fn run(args: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         (None, Some(max_m)) => MatchRule::Euclidean { max_m },
         (None, None) => anyhow::bail!("give --iou or --dist-m"),
     };
+    match rule {
+        MatchRule::Iou { min_iou } if !(min_iou > 0.0 && min_iou <= 1.0) => {
+            anyhow::bail!("--iou {min_iou}: the minimum IoU must lie in (0, 1]")
+        }
+        MatchRule::Euclidean { max_m } if !(max_m > 0.0 && max_m.is_finite()) => {
+            anyhow::bail!(
+                "--dist-m {max_m}: the match distance must be a positive number of metres"
+            )
+        }
+        _ => {}
+    }
     let gt = read(&args.gt, rule.geometry())?;
+    if gt.is_empty() {
+        anyhow::bail!(
+            "{}: no ground-truth rows, so MOTA, IDF1 and HOTA are undefined",
+            args.gt.display()
+        );
+    }
     let hyp = read(&args.hyp, rule.geometry())?;
     let metrics = mot::evaluate(&gt, &hyp, rule)?.metrics;
     if args.json {
