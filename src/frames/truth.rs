@@ -87,14 +87,7 @@ fn read_json<T: serde::de::DeserializeOwned>(
         let m = m?;
         match serde_json::from_slice::<T>(&m.data) {
             Ok(f) => pairs.push((Nanos(stamp(&f)), f)),
-            Err(e) => skips.note(
-                topic,
-                format!(
-                    "{}: topic {topic} at log time {} s: {e}",
-                    log.path().display(),
-                    m.log_time
-                ),
-            ),
+            Err(e) => note_at(&mut skips, log, topic, m.log_time, e),
         }
     }
     Ok((Stamped::new(pairs), skips))
@@ -162,23 +155,26 @@ pub fn person_positions(
                 x,
                 y,
             }),
-            Ok(_) => skips.note(
-                topic,
-                format!(
-                    "{}: topic {topic} at log time {} s: non-finite position",
-                    log.path().display(),
-                    m.log_time
-                ),
-            ),
-            Err(e) => skips.note(
-                topic,
-                format!(
-                    "{}: topic {topic} at log time {} s: {e}",
-                    log.path().display(),
-                    m.log_time
-                ),
-            ),
+            Ok(_) => note_at(&mut skips, log, topic, m.log_time, "non-finite position"),
+            Err(e) => note_at(&mut skips, log, topic, m.log_time, e),
         }
     }
     Ok((rows, skips))
+}
+
+/// Count a bad message on `topic`, its text naming the file, topic and log time.
+fn note_at(
+    skips: &mut Skips,
+    log: &SessionLog,
+    topic: &str,
+    log_time: Nanos,
+    reason: impl std::fmt::Display,
+) {
+    skips.note(
+        topic,
+        format!(
+            "{}: topic {topic} at log time {log_time} s: {reason}",
+            log.path().display()
+        ),
+    );
 }
