@@ -1,6 +1,6 @@
 //! The aggregation, from the cached per-session tables only: CLEAR MOT, IDF1 and HOTA per
 //! sequence × detector in the laser frame under each sequence's protocol (scored scans,
-//! wedge, range), a paired t-test of the per-scan position errors of the two detectors, the
+//! wedge, range), paired t-tests of the per-scan position errors of every two methods, the
 //! sessions' reading statistics, and the tracks as CSV. A listed real sequence without
 //! results gets SKIPPED rows.
 
@@ -9,7 +9,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use super::params::{Params, Sequence};
-use super::tables::{self, DETECTORS, ScanRow, SessionRow, TrackRow, TruthRow};
+use super::methods::Method;
+use super::tables::{self, ScanRow, SessionRow, TrackRow, TruthRow};
 use crate::eval::mot::{EventKind, Geometry, GroundPoint, MatchRule, Observation, evaluate};
 use crate::eval::stats::paired_t;
 use crate::names::sanitize;
@@ -40,16 +41,18 @@ table_row! {
 }
 
 table_row! {
-    /// Paired t-test of the position errors (`legs` − `nearest`) on the (scan, person) pairs
-    /// both detectors matched: `paired_ttest`.
+    /// Paired t-test of the position errors (`method_a` − `method_b`) on the (scan, person)
+    /// pairs both methods matched: `paired_ttest`.
     #[derive(Debug, Clone, PartialEq)]
     pub struct TTestRow {
         pub dataset: String,
         pub sequence: String,
+        pub method_a: String,
+        pub method_b: String,
         pub status: String,
         pub pairs: i64,
-        pub mean_legs_m: Option<f64>,
-        pub mean_nearest_m: Option<f64>,
+        pub mean_a_m: Option<f64>,
+        pub mean_b_m: Option<f64>,
         pub mean_diff_m: Option<f64>,
         pub t: Option<f64>,
         pub df: Option<f64>,
@@ -148,10 +151,10 @@ fn score(d: &SessionData, seq: &Sequence, detector: &str, match_m: f64) -> anyho
     Ok(Scored { row, errors })
 }
 
-fn ttest(d: &SessionData, legs: &Scored, nearest: &Scored, level: f64) -> TTestRow {
+fn ttest(d: &SessionData, first: &Scored, second: &Scored, level: f64) -> TTestRow {
     let (mut a, mut b) = (Vec::new(), Vec::new());
-    for (k, ea) in &legs.errors {
-        if let Some(eb) = nearest.errors.get(k) {
+    for (k, ea) in &first.errors {
+        if let Some(eb) = second.errors.get(k) {
             a.push(*ea);
             b.push(*eb);
         }
@@ -160,10 +163,12 @@ fn ttest(d: &SessionData, legs: &Scored, nearest: &Scored, level: f64) -> TTestR
     let mut row = TTestRow {
         dataset: d.dataset.clone(),
         sequence: d.name.clone(),
+        method_a: first.row.detector.clone(),
+        method_b: second.row.detector.clone(),
         status: "ok".into(),
         pairs: a.len() as i64,
-        mean_legs_m: mean(&a),
-        mean_nearest_m: mean(&b),
+        mean_a_m: mean(&a),
+        mean_b_m: mean(&b),
         mean_diff_m: None,
         t: None,
         df: None,
@@ -185,13 +190,13 @@ fn ttest(d: &SessionData, legs: &Scored, nearest: &Scored, level: f64) -> TTestR
     row
 }
 
-fn skipped_rows(name: &str) -> Vec<ResultRow> {
-    DETECTORS
+fn skipped_rows(name: &str, methods: &[Method]) -> Vec<ResultRow> {
+    methods
         .iter()
-        .map(|det| ResultRow {
+        .map(|m| ResultRow {
             dataset: name.into(),
             sequence: name.into(),
-            detector: (*det).into(),
+            detector: m.name().into(),
             status: "SKIPPED: log absent or not processed".into(),
             scored_scans: None,
             gt_count: None,
@@ -251,11 +256,18 @@ pub(super) fn run(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     let (mut results, mut tests, mut sessions) = (Vec::new(), Vec::new(), Vec::new());
     for d in &data {
         let seq = p.sequence(&d.name);
-        let legs = score(d, seq, DETECTORS[0], p.match_m)?;
-        let nearest = score(d, seq, DETECTORS[1], p.match_m)?;
-        tests.push(ttest(d, &legs, &nearest, p.level));
+        let scored: Vec<Scored> = p
+            .methods
+            .iter()
+            .map(|m| score(d, seq, m.name(), p.match_m))
+            .collect::<anyhow::Result<_>>()?;
+        for (i, a) in scored.iter().enumerate() {
+            for b in &scored[i + 1..] {
+                tests.push(ttest(d, a, b, p.level));
+            }
+        }
         if p.is_listed(&d.name) {
-            for s in [&legs, &nearest] {
+            for s in &scored {
                 let r = &s.row;
                 out.summary.push(format!(
                     "{} {}: MOTA {}, MOTP {} m, IDF1 {}, HOTA {} ({} scored scans, {} ground-truth positions).",
@@ -270,12 +282,11 @@ pub(super) fn run(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
                 ));
             }
         }
-        results.push(legs.row);
-        results.push(nearest.row);
-        for det in DETECTORS {
+        results.extend(scored.into_iter().map(|s| s.row));
+        for m in &p.methods {
             out.artifacts.push((
-                PathBuf::from(format!("tracks/{}_{det}.csv", sanitize(&d.name))),
-                tracks_csv(&d.tracks, det),
+                PathBuf::from(format!("tracks/{}_{}.csv", sanitize(&d.name), m.name())),
+                tracks_csv(&d.tracks, m.name()),
             ));
         }
         let s = &d.session;
@@ -295,7 +306,7 @@ pub(super) fn run(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     }
     for seq in &p.sequences {
         if !data.iter().any(|d| d.name == seq.name) {
-            results.extend(skipped_rows(&seq.name));
+            results.extend(skipped_rows(&seq.name, &p.methods));
             out.summary.push(format!(
                 "{}: SKIPPED (log absent or not processed).",
                 seq.name
@@ -351,20 +362,25 @@ fn push_tables(
     }
     out.tables.push(
         t.with_note(format!(
-            "Matching: Euclidean in the laser frame, threshold {} m (CLEAR MOT as py-motmetrics, IDF1, HOTA with zero similarity at {} m). legs: seed 002 leg model + PeopleTracker (confirmed tracks); nearest: midpoint of the two legs nearest to the laser, no filter, one id. Detector and tracker at the defaults of src/laser (chosen on synthetic data, not tuned on these logs).",
+            "Matching: Euclidean in the laser frame, threshold {} m (CLEAR MOT as py-motmetrics, IDF1, HOTA with zero similarity at {} m). {} Detectors and tracker at the defaults of src/laser (chosen on synthetic data, not tuned on these logs).",
             p.match_m,
-            2.0 * p.match_m
+            2.0 * p.match_m,
+            p.methods
+                .iter()
+                .map(|m| format!("{}: {}.", m.name(), m.describe()))
+                .collect::<Vec<_>>()
+                .join(" ")
         ))
         .with_note(protocol_note(p)),
     );
     let mut t = Table::new(
         "paired_ttest",
-        "Position error of legs vs nearest on the (scan, person) pairs both matched: paired t-test",
+        "Position error of every two methods on the (scan, person) pairs both matched: paired t-test",
         TTestRow::frame(tests)?,
     );
     for c in [
-        "mean_legs_m",
-        "mean_nearest_m",
+        "mean_a_m",
+        "mean_b_m",
         "mean_diff_m",
         "t",
         "ci_low_m",
@@ -376,7 +392,7 @@ fn push_tables(
         t.with_precision("df", 0)
             .with_precision("p_two_sided", 4)
             .with_note(format!(
-                "Two-sided, confidence level {}; differences are legs − nearest (negative: legs closer to the ground truth).",
+                "Two-sided, confidence level {}; differences are method_a − method_b (negative: method_a closer to the ground truth).",
                 p.level
             )),
     );

@@ -2,16 +2,17 @@
 //! synthetic laser logs.
 //!
 //! Per session ([`session`], cached as the rows of [`tables`]): every scan of the sequence's
-//! laser topic through two detectors, `legs` (seed 002 leg model → people → `PeopleTracker`)
-//! and `nearest` (the midpoint of the two legs nearest to the laser, no filter, one id), with
-//! the ground truth on its scans, all in the laser frame. The aggregation ([`aggregate`])
-//! scores each sequence × detector with CLEAR MOT, IDF1 and HOTA under the sequence's
-//! protocol ([`params::Sequence`]: scored scans, bearing wedge, range), runs a paired t-test
-//! of the two detectors' position errors, and writes the tracks as CSV. The real sequences
+//! laser topic through every method of [`methods`] (`legs`: seed 002 leg model → people →
+//! `PeopleTracker`; `nearest`: the midpoint of the two legs nearest to the laser, no filter,
+//! one id), with the ground truth on its scans, all in the laser frame. The aggregation
+//! ([`aggregate`]) scores each sequence × method with CLEAR MOT, IDF1 and HOTA under the
+//! sequence's protocol ([`params::Sequence`]: scored scans, bearing wedge, range), runs paired
+//! t-tests of the methods' position errors, and writes the tracks as CSV. The real sequences
 //! (Leigh et al., ICRA 2015) are read in place from `../shared/real/laser/`; listed ones that
 //! are absent get SKIPPED rows.
 
 mod aggregate;
+mod methods;
 mod params;
 mod session;
 mod tables;
@@ -28,7 +29,7 @@ pub struct LaserPeople;
 
 impl Experiment for LaserPeople {
     const KIND: &'static str = "laser_people";
-    const VERSION: u32 = 1;
+    const VERSION: u32 = 2;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {
@@ -48,7 +49,7 @@ impl Experiment for LaserPeople {
         gt.dedup();
         vec![
             Stage {
-                name: "legs + tracker, nearest baseline".into(),
+                name: "laser methods (leg model + tracker, nearest baseline, …)".into(),
                 requires: vec![],
                 optional: [scans, vec!["/tf".into(), "/tf_static".into()]].concat(),
             },

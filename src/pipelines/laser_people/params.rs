@@ -4,6 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::methods::Method;
 use crate::groundtruth::PEOPLE_TOPIC;
 use crate::run::config::Invalid;
 
@@ -47,6 +48,8 @@ pub struct Params {
     pub sequences: Vec<Sequence>,
     /// How every other session (the synthetic datasets) is read and scored (`name` unused).
     pub synthetic: Sequence,
+    /// The methods run on every scan, in table order (see [`super::methods`]).
+    pub methods: Vec<Method>,
 }
 
 impl Default for Params {
@@ -64,6 +67,7 @@ impl Default for Params {
                 wedge_deg: None,
                 max_range_m: None,
             },
+            methods: vec![Method::Legs, Method::Nearest],
         }
     }
 }
@@ -157,6 +161,14 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
         check_sequence("sequences", s, &mut out);
     }
     check_sequence("synthetic", &p.synthetic, &mut out);
+    if p.methods.is_empty() {
+        out.push(("methods".into(), "needs at least one method".into()));
+    }
+    let mut sorted = p.methods.clone();
+    sorted.sort();
+    if sorted.windows(2).any(|w| w[0] == w[1]) {
+        out.push(("methods".into(), "lists a method twice".into()));
+    }
     out
 }
 
@@ -191,5 +203,17 @@ mod tests {
         p.synthetic.scans = Some([5, 2]);
         let keys: Vec<String> = validate(&p).into_iter().map(|(k, _)| k).collect();
         assert_eq!(keys, ["match_m", "synthetic"]);
+        let p = Params {
+            methods: vec![Method::Nearest, Method::Legs, Method::Nearest],
+            ..Params::default()
+        };
+        let keys: Vec<String> = validate(&p).into_iter().map(|(k, _)| k).collect();
+        assert_eq!(keys, ["methods"]);
+        let p = Params {
+            methods: vec![],
+            ..Params::default()
+        };
+        let keys: Vec<String> = validate(&p).into_iter().map(|(k, _)| k).collect();
+        assert_eq!(keys, ["methods"]);
     }
 }

@@ -1,15 +1,12 @@
 //! The per-session stage: every scan of the sequence's laser topic through the leg model of
-//! [`crate::laser`] and both detectors, the ground truth placed on its scans, all in the laser
+//! [`crate::laser`] and every method, the ground truth placed on its scans, all in the laser
 //! frame; the rows of [`super::tables`].
 //!
 //! - **Scans** come from [`frames::laser::scans`] with the sensor pose at the scan stamp in the
 //!   fixed frame (`odom` when TF has it; the synthetic logs' `map`, their ground truth's frame;
 //!   the sensor frame without TF). Scan indices count the decoded scans in log order.
-//! - **`legs`**: jump-distance segments → seed 002 leg model → leg pairs (people) and single
-//!   legs in the fixed frame → [`PeopleTracker`]; its confirmed tracks after each scan, put
-//!   back into the laser frame through the inverse pose.
-//! - **`nearest`**: the baseline without a filter: the midpoint of the two legs nearest to the
-//!   laser (any distance apart), one hypothesis with id 1 on each scan with two legs or more.
+//! - **Methods** ([`super::methods`], the pipeline's `methods` in order): each turns the scan
+//!   into fixed-frame hypotheses, put back into the laser frame through the inverse pose.
 //! - **Ground truth**: `leg_tracker/msg/Person` messages (real logs) are already in the laser
 //!   frame and belong to the last scan logged before them (the README's and `clear_mot.py`'s
 //!   rule); synthetic `/ground_truth/people` frames (map frame) are joined to a scan by nearest
@@ -17,14 +14,11 @@
 
 use nalgebra::{Isometry3, Point2, Point3};
 
+use super::methods::{Method, Runner, ScanView};
 use super::params::{Params, Sequence};
 use super::tables::{self, ScanRow, SessionRow, TrackRow, TruthRow};
 use crate::frames::laser::{self as laser_frames, LaserFrame, LaserOptions};
 use crate::frames::{Skips, truth};
-use crate::laser::legs::{self, Detections, LegParams};
-use crate::laser::points::{self, ScanGeometry};
-use crate::laser::segment::{self, SegmentOptions};
-use crate::laser::tracker::{PeopleTracker, TrackerParams};
 use crate::log::SessionLog;
 use crate::log::decode::carries;
 use crate::progress::Progress;
@@ -81,43 +75,6 @@ fn to_laser(pose: Option<&Isometry3<f64>>, p: Point2<f64>) -> Point2<f64> {
     }
 }
 
-/// The leg model on one scan.
-fn detect(f: &LaserFrame) -> Detections {
-    let g = ScanGeometry {
-        angle_min: f64::from(f.scan.angle_min),
-        angle_increment: f64::from(f.scan.angle_increment),
-        range_min: f64::from(f.scan.range_min),
-        range_max: f64::from(f.scan.range_max),
-    };
-    let pts = points::project(&f.scan.ranges, &g, f.pose.as_ref());
-    let segs = segment::segment(&pts, &SegmentOptions::default());
-    legs::detect(
-        &pts,
-        &segs,
-        f.scan.ranges.len(),
-        f.pose.as_ref(),
-        &LegParams::default(),
-    )
-}
-
-/// The `nearest` baseline: the midpoint of the two legs nearest to the laser, as
-/// `(laser frame, fixed frame)`; ties by leg order.
-pub fn nearest_pair(d: &Detections) -> Option<(Point2<f64>, Point2<f64>)> {
-    let mut order: Vec<usize> = (0..d.legs.len()).collect();
-    order.sort_by(|&a, &b| {
-        let (ra, rb) = (
-            d.legs[a].sensor.coords.norm(),
-            d.legs[b].sensor.coords.norm(),
-        );
-        ra.total_cmp(&rb).then(a.cmp(&b))
-    });
-    let (a, b) = (&d.legs[*order.first()?], &d.legs[*order.get(1)?]);
-    Some((
-        nalgebra::center(&a.sensor, &b.sensor),
-        nalgebra::center(&a.fixed, &b.fixed),
-    ))
-}
-
 fn track_row(
     detector: &str,
     idx: i64,
@@ -136,28 +93,24 @@ fn track_row(
     }
 }
 
-/// One scan through both detectors (and the synthetic ground truth, when given).
+/// One scan through every method (and the synthetic ground truth, when given).
 fn scan_step(
     f: &LaserFrame,
     idx: i64,
     time_s: f64,
-    tracker: &mut PeopleTracker,
+    runners: &mut [(Method, Runner)],
     gt: Option<&crate::groundtruth::PeopleFrame>,
     out: &mut Collected,
 ) {
-    let d = detect(f);
-    let people: Vec<Point2<f64>> = d.people.iter().map(|p| p.fixed).collect();
-    let single: Vec<Point2<f64>> = d.single_legs.iter().map(|&i| d.legs[i].fixed).collect();
-    tracker.step(time_s, &people, &single);
+    let view = ScanView::new(f);
+    let d = &view.geometric;
     let pose = f.pose.as_ref();
-    for t in tracker.confirmed() {
-        let world = t.position();
-        let id = i64::try_from(t.id).unwrap_or(i64::MAX);
-        out.tracks
-            .push(track_row("legs", idx, id, to_laser(pose, world), world));
-    }
-    if let Some((laser, world)) = nearest_pair(&d) {
-        out.tracks.push(track_row("nearest", idx, 1, laser, world));
+    for (method, runner) in runners.iter_mut() {
+        for h in runner.step(&view, time_s) {
+            let laser = h.laser.unwrap_or_else(|| to_laser(pose, h.world));
+            out.tracks
+                .push(track_row(method.name(), idx, h.id, laser, h.world));
+        }
     }
     if let Some(frame) = gt {
         for person in &frame.people {
@@ -245,7 +198,8 @@ pub(super) fn process(
         .zip(summary.statistics.as_ref())
         .and_then(|(c, st)| st.channel_message_counts.get(&c.id).copied());
     bar.set_length(expected.unwrap_or(0));
-    let mut tracker = PeopleTracker::new(TrackerParams::default());
+    let mut runners: Vec<(Method, Runner)> =
+        p.methods.iter().map(|&m| (m, Runner::new(m))).collect();
     let mut out = Collected::default();
     let mut first: Option<Nanos> = None;
     for (idx, f) in frames.by_ref().enumerate() {
@@ -255,7 +209,7 @@ pub(super) fn process(
         let gt = (kind == GtKind::Synthetic)
             .then(|| synthetic.nearest(f.stamp, tolerance_ns))
             .flatten();
-        scan_step(&f, idx as i64, time_s, &mut tracker, gt, &mut out);
+        scan_step(&f, idx as i64, time_s, &mut runners, gt, &mut out);
         bar.inc(1);
     }
     let fixed_frame = frames.fixed_frame().unwrap_or_default().to_string();

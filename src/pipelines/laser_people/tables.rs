@@ -12,9 +12,6 @@ pub const SCANS: &str = "scans";
 pub const TRUTH: &str = "truth";
 pub const TRACKS: &str = "tracks";
 
-/// The two detectors, in table order.
-pub const DETECTORS: [&str; 2] = ["legs", "nearest"];
-
 table_row! {
     /// What one session read: `session` (one row).
     #[derive(Debug, Clone, PartialEq)]
