@@ -91,6 +91,12 @@ pub trait Experiment: Sync {
         Vec::new()
     }
 
+    /// Every logical topic name `[topics]` may remap (any other key is an error naming it).
+    /// The default: none, for experiments that take their topics from `[params]`.
+    fn topic_keys(_params: &Self::Params) -> Vec<String> {
+        Vec::new()
+    }
+
     /// The stages and the topics they read, with `[topics]` remaps applied.
     fn plan(params: &Self::Params, topics: &BTreeMap<String, String>) -> Vec<Stage>;
 
@@ -250,6 +256,7 @@ fn plan<E: Experiment>(
 ) -> anyhow::Result<Plan<E::Params>> {
     let file: PipelineFile<E::Params> = config::parse(path, text)?;
     config::check(path, text, E::validate(&file.params))?;
+    config::check_topics(path, text, &file.topics, &E::topic_keys(&file.params))?;
     let stages = E::plan(&file.params, &file.topics);
     let patterns = opts
         .sessions
