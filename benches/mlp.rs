@@ -54,7 +54,7 @@ fn splits() -> Vec<Vec<usize>> {
 fn train(xs: &[Vec<f64>], ys: &[f64], split: &[usize], s: usize) -> Regressor {
     let tx: Vec<Vec<f64>> = split.iter().map(|i| xs[*i].clone()).collect();
     let ty: Vec<f64> = split.iter().map(|i| ys[*i]).collect();
-    Regressor::fit(&tx, &ty, SPEC, &mut stream(7, "net", s as u64))
+    Regressor::fit(&tx, &ty, SPEC, &mut stream(7, "net", s as u64)).expect("valid training data")
 }
 
 fn test_error(xs: &[Vec<f64>], ys: &[f64], split: &[usize], m: &Regressor) -> f64 {

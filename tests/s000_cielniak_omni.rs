@@ -188,3 +188,45 @@ fn calibrates_learns_tracks_and_the_saved_model_reproduces_its_estimates() {
 fn outs_dir(out: &Path) -> PathBuf {
     out.join("s000_cielniak_omni")
 }
+
+/// Regressions (issue 19): `train_fraction = 0.001` panicked (index out of bounds when the
+/// network was fitted on no frames), and `background_frames` longer than the log ended in
+/// "only 0 frames have both omni features and a measured position", naming no parameter.
+/// Both depend on the data, so they are met at run time; each is an error naming it.
+#[test]
+fn degenerate_values_met_at_run_time_name_the_parameter() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scenario = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/omni_tiny.toml");
+    let logs = dir.path().join("logs");
+    synthesize(
+        &scenario,
+        &SynthOptions {
+            profile: "quick".into(),
+            out: Some(logs.clone()),
+            progress: None,
+        },
+    )
+    .expect("synthesizes");
+    let glob = format!("{}/*.mcap", logs.display());
+    let out = dir.path().join("out");
+
+    let tiny = pipeline(dir.path(), "tiny", &glob, "train_fraction = 0.001");
+    let err = format!(
+        "{:#}",
+        run_file(&tiny, &opts(&out)).expect_err("no training frames")
+    );
+    assert!(
+        err.contains("params.train_fraction = 0.001") && err.contains("into 0 training"),
+        "{err}"
+    );
+
+    let long = pipeline(dir.path(), "long", &glob, "background_frames = 100000");
+    let err = format!(
+        "{:#}",
+        run_file(&long, &opts(&out)).expect_err("no frames left")
+    );
+    assert!(
+        err.contains("params.background_frames = 100000") && err.contains("none left"),
+        "{err}"
+    );
+}

@@ -78,7 +78,11 @@ pub fn run(args: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         );
     }
     let hyp = read(&args.hyp, rule.geometry())?;
-    let metrics = mot::evaluate(&gt, &hyp, rule)?.metrics;
+    // the sequence keeps what the metrics need (dense ids and geometry, grouped by frame);
+    // the parsed rows go before the metrics run, and no per-frame events are collected
+    let sequence = mot::Sequence::new(&gt, &hyp, rule)?;
+    drop((gt, hyp));
+    let metrics = sequence.metrics();
     if args.json {
         let v = serde_json::json!({
             "gt": args.gt.display().to_string(),

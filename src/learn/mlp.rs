@@ -155,16 +155,79 @@ pub struct TrainSpec {
     pub epochs: usize,
 }
 
+/// Why a network cannot be trained: degenerate data or settings (never a panic).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MlpError {
+    #[error("no training rows")]
+    NoRows,
+    #[error("{xs} feature rows but {ys} targets")]
+    LengthMismatch { xs: usize, ys: usize },
+    #[error("feature row {row} has {len} values, row 0 has {first}")]
+    Ragged {
+        row: usize,
+        len: usize,
+        first: usize,
+    },
+    #[error("rows have no features")]
+    NoFeatures,
+    #[error("zero epochs leave the network untrained")]
+    NoEpochs,
+    #[error("a network needs at least one hidden unit")]
+    NoHidden,
+    #[error("learning rate {0} is not a finite positive number")]
+    BadLearningRate(f64),
+}
+
+impl TrainSpec {
+    /// Check the settings: at least one hidden unit and one epoch, a finite positive rate.
+    pub fn validate(&self) -> Result<(), MlpError> {
+        if self.hidden == 0 {
+            return Err(MlpError::NoHidden);
+        }
+        if self.epochs == 0 {
+            return Err(MlpError::NoEpochs);
+        }
+        if !(self.learning_rate.is_finite() && self.learning_rate > 0.0) {
+            return Err(MlpError::BadLearningRate(self.learning_rate));
+        }
+        Ok(())
+    }
+}
+
 impl Regressor {
-    /// Fit on `(xs, ys)` with a seeded generator (initial weights and sample order).
-    pub fn fit(xs: &[Vec<f64>], ys: &[f64], spec: TrainSpec, rng: &mut ChaCha8Rng) -> Regressor {
+    /// Fit on `(xs, ys)` with a seeded generator (initial weights and sample order). Empty or
+    /// ragged data and degenerate settings are errors.
+    pub fn fit(
+        xs: &[Vec<f64>],
+        ys: &[f64],
+        spec: TrainSpec,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Regressor, MlpError> {
+        spec.validate()?;
+        if xs.len() != ys.len() {
+            return Err(MlpError::LengthMismatch {
+                xs: xs.len(),
+                ys: ys.len(),
+            });
+        }
+        let first = xs.first().ok_or(MlpError::NoRows)?.len();
+        if first == 0 {
+            return Err(MlpError::NoFeatures);
+        }
+        if let Some((row, r)) = xs.iter().enumerate().find(|(_, r)| r.len() != first) {
+            return Err(MlpError::Ragged {
+                row,
+                len: r.len(),
+                first,
+            });
+        }
         let input = Normalizer::fit(xs);
         let target = Normalizer::fit(&ys.iter().map(|y| vec![*y]).collect::<Vec<_>>());
         let xn: Vec<Vec<f64>> = xs.iter().map(|x| input.apply(x)).collect();
         let yn: Vec<f64> = ys.iter().map(|y| target.apply(&[*y])[0]).collect();
         let mut net = Mlp::new(input.min.len(), spec.hidden, rng);
         net.train(&xn, &yn, spec.learning_rate, spec.epochs, rng);
-        Regressor { input, target, net }
+        Ok(Regressor { input, target, net })
     }
 
     pub fn predict(&self, x: &[f64]) -> f64 {
@@ -176,6 +239,41 @@ impl Regressor {
 mod tests {
     use super::*;
     use crate::rng;
+
+    /// Regression (issue 19): no rows, zero epochs and ragged rows were an index out of
+    /// bounds or an untrained network; now each is its error.
+    #[test]
+    fn degenerate_training_is_an_error() {
+        let mut r = rng::stream(3, "t", 0);
+        let spec = TrainSpec {
+            hidden: 2,
+            learning_rate: 0.3,
+            epochs: 5,
+        };
+        let fit = |xs: &[Vec<f64>], ys: &[f64], spec, r: &mut ChaCha8Rng| {
+            Regressor::fit(xs, ys, spec, r).map(|_| ())
+        };
+        assert_eq!(fit(&[], &[], spec, &mut r), Err(MlpError::NoRows));
+        let zero = TrainSpec { epochs: 0, ..spec };
+        assert_eq!(
+            fit(&[vec![1.0]], &[1.0], zero, &mut r),
+            Err(MlpError::NoEpochs)
+        );
+        let ragged = [vec![1.0, 2.0], vec![1.0]];
+        assert_eq!(
+            fit(&ragged, &[1.0, 2.0], spec, &mut r),
+            Err(MlpError::Ragged {
+                row: 1,
+                len: 1,
+                first: 2
+            })
+        );
+        assert_eq!(
+            fit(&[vec![1.0]], &[1.0, 2.0], spec, &mut r),
+            Err(MlpError::LengthMismatch { xs: 1, ys: 2 })
+        );
+        assert_eq!(fit(&[vec![1.0]], &[1.0], spec, &mut r), Ok(()));
+    }
 
     #[test]
     fn gradient_matches_finite_differences() {
@@ -223,7 +321,8 @@ mod tests {
                 epochs: 1500,
             },
             &mut r,
-        );
+        )
+        .expect("valid data");
         let mse: f64 = pts[400..]
             .iter()
             .zip(&ys[400..])

@@ -65,6 +65,10 @@ impl Experiment for DatasetQuality {
         out
     }
 
+    fn topic_keys(_: &Params) -> Vec<String> {
+        vec!["ground_truth".into()]
+    }
+
     fn plan(_: &Params, topics: &BTreeMap<String, String>) -> Vec<Stage> {
         vec![
             Stage {

@@ -1,6 +1,9 @@
 //! Pipeline files (`pipelines/*.toml`), parsed in two steps (raw TOML → typed, validated
 //! config). Unknown keys and wrongly typed values are errors with the file, line and column
-//! (from the TOML parser); values out of range are errors with the line of the key.
+//! (from the TOML parser); values out of range are errors with the line of the key and its
+//! full key path (`params.local_eval.min_iou`, `params.sequences[1].scans`), found in the
+//! document the `toml` crate parses with spans ([`toml::de::DeTable`]). A `[topics]` key the
+//! experiment does not remap is an error naming it.
 //!
 //! ```toml
 //! [pipeline]
@@ -13,7 +16,7 @@
 //! exclude = ["*.tmp"]
 //!
 //! [topics]                        # logical name -> topic, for logs that use other names
-//! scan = "/scan"
+//! ground_truth = "/ground_truth/people"
 //!
 //! [params]                        # the experiment's own parameters (paper defaults)
 //! bin_s = 1.0
@@ -34,10 +37,13 @@ pub enum ConfigError {
     },
     #[error("{path}: {message}")]
     Parse { path: PathBuf, message: String },
-    #[error("{path}:{line}: `{key}`: {reason}")]
+    /// A value out of range (or a key the experiment does not know). `line` is the line of the
+    /// key, or of the deepest table above it that the file writes when the key itself is not
+    /// written (a default); `None` when the file writes none of its path.
+    #[error("{path}{}: `{key}`: {reason}", line.map_or(String::new(), |l| format!(":{l}")))]
     Invalid {
         path: PathBuf,
-        line: usize,
+        line: Option<usize>,
         key: String,
         reason: String,
     },
@@ -117,40 +123,125 @@ pub fn parse<P: DeserializeOwned + Default>(
     })
 }
 
-/// Line (1-based) of `key` inside `[section]` of a TOML text, for validation messages.
-pub fn line_of(text: &str, section: &str, key: &str) -> usize {
-    let mut in_section = false;
-    let header = format!("[{section}]");
-    for (i, line) in text.lines().enumerate() {
-        let t = line.trim();
-        if t.starts_with('[') {
-            in_section = t == header;
-            continue;
-        }
-        if in_section
-            && let Some((k, _)) = t.split_once('=')
-            && k.trim() == key
-        {
-            return i + 1;
-        }
-    }
-    0
+/// One step of a key path: a table key or an index into an array (of tables).
+#[derive(Debug, Clone, PartialEq)]
+enum Step {
+    Key(String),
+    Index(usize),
 }
 
-/// A validation failure of one parameter: `(key within [params], reason)`.
+/// `a.b[2].c` → `[Key(a), Key(b), Index(2), Key(c)]`. Keys are bare TOML keys (no dots or
+/// brackets inside), as every parameter name is.
+fn steps(path: &str) -> Vec<Step> {
+    let mut out = Vec::new();
+    for part in path.split('.') {
+        let (key, mut rest) = part.split_once('[').map_or((part, ""), |(k, r)| (k, r));
+        if !key.is_empty() {
+            out.push(Step::Key(key.to_string()));
+        }
+        while let Some((index, after)) = rest.split_once(']') {
+            if let Ok(i) = index.parse() {
+                out.push(Step::Index(i));
+            }
+            rest = after.strip_prefix('[').unwrap_or(after);
+        }
+    }
+    out
+}
+
+/// Line (1-based) of the key at `path` (`params.local_eval.min_iou`, `params.sequences[1]`) in
+/// a TOML text, and whether the whole path was found. When the file does not write the key
+/// (a default), the line of the deepest table on the path that it writes; `None` when it
+/// writes none of it (or the text does not parse).
+pub fn line_of(text: &str, path: &str) -> Option<(usize, bool)> {
+    use toml::de::{DeTable, DeValue};
+    let doc = DeTable::parse(text).ok()?;
+    let line = |offset: usize| text[..offset.min(text.len())].matches('\n').count() + 1;
+    let mut table: &DeTable = doc.get_ref();
+    let mut value: Option<&toml::Spanned<DeValue>> = None;
+    let mut found: Option<usize> = None;
+    let path = steps(path);
+    for (k, step) in path.iter().enumerate() {
+        let next = match (step, value.map(toml::Spanned::get_ref)) {
+            (Step::Key(key), None | Some(DeValue::Table(_))) => {
+                if let Some(DeValue::Table(t)) = value.map(toml::Spanned::get_ref) {
+                    table = t;
+                }
+                table
+                    .iter()
+                    .find(|(name, _)| name.get_ref().as_ref() == key.as_str())
+                    .map(|(name, v)| (name.span().start, v))
+            }
+            (Step::Index(i), Some(DeValue::Array(a))) => a.get(*i).map(|v| (v.span().start, v)),
+            _ => None,
+        };
+        let Some((offset, v)) = next else {
+            return found.map(|l| (l, false));
+        };
+        found = Some(line(offset));
+        value = Some(v);
+        if k + 1 == path.len() {
+            return found.map(|l| (l, true));
+        }
+    }
+    found.map(|l| (l, true))
+}
+
+/// A validation failure of one parameter: `(key path within [params], reason)`. The path
+/// names the key as the file writes it: `roc.adaptive.history`, `sequences[1].scans`.
 pub type Invalid = (String, String);
 
-/// Turn the first validation failure into an error with its line.
+/// Turn the first validation failure into an error with its line and full key path.
 pub fn check(path: &Path, text: &str, problems: Vec<Invalid>) -> Result<(), ConfigError> {
     match problems.into_iter().next() {
         None => Ok(()),
-        Some((key, reason)) => Err(ConfigError::Invalid {
-            path: path.to_path_buf(),
-            line: line_of(text, "params", &key),
-            key: format!("params.{key}"),
-            reason,
-        }),
+        Some((key, reason)) => Err(invalid(path, text, &format!("params.{key}"), reason)),
     }
+}
+
+/// The error for the key at `key_path` (from the top of the file), with its line.
+pub fn invalid(path: &Path, text: &str, key_path: &str, reason: String) -> ConfigError {
+    let (line, exact) = line_of(text, key_path).map_or((None, false), |(l, e)| (Some(l), e));
+    ConfigError::Invalid {
+        path: path.to_path_buf(),
+        line,
+        key: key_path.to_string(),
+        reason: if exact || line.is_none() {
+            reason
+        } else {
+            format!("{reason} (not set in the file: the default)")
+        },
+    }
+}
+
+/// `[topics]` keys that the experiment does not remap are errors naming them; `known` is
+/// every logical name it reads.
+pub fn check_topics(
+    path: &Path,
+    text: &str,
+    topics: &BTreeMap<String, String>,
+    known: &[String],
+) -> Result<(), ConfigError> {
+    let Some(unknown) = topics.keys().find(|k| !known.contains(k)) else {
+        return Ok(());
+    };
+    let reason = if known.is_empty() {
+        "unknown topic name: this pipeline takes no [topics] remaps".to_string()
+    } else {
+        format!(
+            "unknown topic name (this pipeline remaps: {})",
+            known.join(", ")
+        )
+    };
+    // a quoted key with dots or brackets cannot be found as a path: the table's line then
+    let key_path = format!("topics.{unknown}");
+    let mut e = invalid(path, text, &key_path, reason);
+    if let ConfigError::Invalid { reason, .. } = &mut e
+        && let Some(r) = reason.strip_suffix(" (not set in the file: the default)")
+    {
+        *reason = r.to_string();
+    }
+    Err(e)
 }
 
 /// A session found by the input globs.
@@ -250,7 +341,7 @@ mod tests {
     fn parses_and_finds_lines() {
         let f: PipelineFile<P> = parse(Path::new("p.toml"), GOOD).expect("parses");
         assert_eq!(f.params.alpha, 0.5);
-        assert_eq!(line_of(GOOD, "params", "alpha"), 10);
+        assert_eq!(line_of(GOOD, "params.alpha"), Some((10, true)));
         let e = check(
             Path::new("p.toml"),
             GOOD,

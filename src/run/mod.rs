@@ -12,14 +12,16 @@
 //!
 //! 4. **Write**: the products go under `out/<pipeline>/` atomically, listed in the summary.
 //!
-//! A session that cannot be processed (unreadable log, missing topic, a panic in `process`) is
-//! skipped, counted and listed with its reason in the run summary and the report — never
-//! silently dropped; the other sessions' results are kept. The cache lives in `cache`
+//! A session that cannot be processed (unreadable log, missing topic, an error or a panic in
+//! `process`) is skipped, counted and listed with its reason in the run summary, in the
+//! pipeline's `skipped_sessions` table ([`skipped`], written by the runner for every pipeline)
+//! and in the report — never silently dropped; the other sessions' results are kept. The cache lives in `cache`
 //! (`--aggregate-only` reads it without the logs).
 
 mod cache;
 pub mod config;
 pub mod report;
+pub mod skipped;
 
 use std::collections::BTreeMap;
 use std::panic::{self, AssertUnwindSafe};
@@ -91,6 +93,12 @@ pub trait Experiment: Sync {
         Vec::new()
     }
 
+    /// Every logical topic name `[topics]` may remap (any other key is an error naming it).
+    /// The default: none, for experiments that take their topics from `[params]`.
+    fn topic_keys(_params: &Self::Params) -> Vec<String> {
+        Vec::new()
+    }
+
     /// The stages and the topics they read, with `[topics]` remaps applied.
     fn plan(params: &Self::Params, topics: &BTreeMap<String, String>) -> Vec<Stage>;
 
@@ -143,6 +151,9 @@ pub struct RunSummary {
     pub computed: usize,
     pub cached: usize,
     pub skipped: Vec<(String, String)>,
+    /// Path (relative to out/) of the `skipped_sessions` table's Markdown; empty when it was
+    /// not written (dry runs, shards).
+    pub skipped_table: String,
     /// `(caption, path relative to out/)` of each table's Markdown.
     pub tables: Vec<(String, String)>,
     pub figures: Vec<(String, String)>,
@@ -250,6 +261,7 @@ fn plan<E: Experiment>(
 ) -> anyhow::Result<Plan<E::Params>> {
     let file: PipelineFile<E::Params> = config::parse(path, text)?;
     config::check(path, text, E::validate(&file.params))?;
+    config::check_topics(path, text, &file.topics, &E::topic_keys(&file.params))?;
     let stages = E::plan(&file.params, &file.topics);
     let patterns = opts
         .sessions
@@ -328,7 +340,7 @@ fn session_tables<E: Experiment>(
     let file_hash = if opts.aggregate_only && !s.path.exists() {
         match cache::recorded_hash(&dir) {
             Some(h) => h,
-            None => anyhow::bail!("no cached result for this session (run the shards first)"),
+            None => anyhow::bail!(skipped::NOT_CACHED),
         }
     } else {
         cache::hash_file(&s.path).with_context(|| format!("reading {}", s.path.display()))?
@@ -340,12 +352,12 @@ fn session_tables<E: Experiment>(
         return Ok((tables, true));
     }
     if opts.aggregate_only {
-        anyhow::bail!("no cached result for this session (run the shards first)");
+        anyhow::bail!(skipped::NOT_CACHED);
     }
     let log = SessionLog::open(&s.path)?;
     let missing = missing_topics(&log, &job.plan.stages);
     if !missing.is_empty() {
-        anyhow::bail!("missing topic(s) {}", missing.join(", "));
+        anyhow::bail!("{}{}", skipped::MISSING_TOPICS, missing.join(", "));
     }
     let bar = job.bars.bar(&format!("{}/{}", s.dataset, s.name), "");
     let session = Session {
@@ -391,7 +403,13 @@ fn process_sessions<E: Experiment>(job: &SessionJob<E::Params>) -> Vec<Outcome> 
         .par_iter()
         .map(|s| {
             let outcome = panic::catch_unwind(AssertUnwindSafe(|| session_tables::<E>(job, s)))
-                .unwrap_or_else(|p| Err(anyhow::anyhow!("panicked: {}", panic_message(&*p))));
+                .unwrap_or_else(|p| {
+                    Err(anyhow::anyhow!(
+                        "{}{}",
+                        skipped::PANICKED,
+                        panic_message(&*p)
+                    ))
+                });
             total.inc(1);
             match outcome {
                 Ok((tables, cached)) => Ok((s.clone(), tables, cached)),
@@ -462,6 +480,7 @@ pub fn run_experiment<E: Experiment>(
         computed: 0,
         cached: 0,
         skipped: Vec::new(),
+        skipped_table: String::new(),
         tables: Vec::new(),
         figures: Vec::new(),
         summary: Vec::new(),
@@ -493,6 +512,7 @@ pub fn run_experiment<E: Experiment>(
         bars: reporter(&opts.progress),
     };
     let mut done = Vec::new();
+    let mut not_done = Vec::new();
     for outcome in process_sessions::<E>(&job) {
         match outcome {
             Ok((s, tables, cached)) => {
@@ -503,9 +523,12 @@ pub fn run_experiment<E: Experiment>(
                 }
                 done.push((s, tables));
             }
-            Err((s, reason)) => summary
-                .skipped
-                .push((format!("{}/{}", s.dataset, s.name), reason)),
+            Err((s, reason)) => {
+                summary
+                    .skipped
+                    .push((format!("{}/{}", s.dataset, s.name), reason.clone()));
+                not_done.push((s, reason));
+            }
         }
     }
     if opts.shard.is_some() {
@@ -532,6 +555,13 @@ pub fn run_experiment<E: Experiment>(
         &file.params,
     )?;
     write_products(products, &opts.out, &provenance, &mut summary)?;
+    let skipped_table = skipped::table(&not_done, &provenance)?;
+    write_table(
+        &opts.out.join(&name).join("tables"),
+        &skipped_table,
+        &opts.out,
+    )?;
+    summary.skipped_table = format!("{name}/tables/{}.md", skipped::TABLE);
     summary.seconds = started.elapsed().as_secs_f64();
     Ok(summary)
 }

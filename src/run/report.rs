@@ -1,6 +1,8 @@
 //! `out/REPORT.md`: one section per pipeline with its summary lines, every table inline (and
-//! linked as CSV, Parquet, LaTeX), every figure, skipped sessions with reasons, and versions
-//! and timings. Pure: the caller reads the table files and writes the result.
+//! linked as CSV, Parquet, LaTeX), every figure, the sessions without results (skipped, failed,
+//! panicked) with their reasons and a link to the pipeline's `skipped_sessions` table (a
+//! section in every pipeline, saying "none" when none), and versions and timings. Pure: the
+//! caller reads the table files and writes the result.
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -78,10 +80,22 @@ pub fn render(runs: &[RunSummary], tables_md: &BTreeMap<String, String>, h: &Hea
             let svg = path.trim_end_matches(".png");
             let _ = writeln!(o, "### {title}\n\n![{title}]({path})\n\n[svg]({svg}.svg)\n");
         }
-        if !r.skipped.is_empty() {
+        if !r.skipped.is_empty() || !r.skipped_table.is_empty() {
             let _ = writeln!(o, "### Skipped sessions ({})\n", r.skipped.len());
+            if r.skipped.is_empty() {
+                let _ = writeln!(o, "None: every session gave results.");
+            }
             for (s, why) in &r.skipped {
-                let _ = writeln!(o, "- `{s}`: {why}");
+                let status = super::skipped::status(why);
+                let _ = writeln!(o, "- `{s}` ({status}): {why}");
+            }
+            if !r.skipped_table.is_empty() {
+                let stem = r.skipped_table.trim_end_matches(".md");
+                let _ = writeln!(
+                    o,
+                    "\nTable: [md]({}) · [csv]({stem}.csv) · [parquet]({stem}.parquet)",
+                    r.skipped_table
+                );
             }
             o.push('\n');
         }
@@ -115,7 +129,11 @@ mod tests {
             sessions: 3,
             computed: 2,
             cached: 0,
-            skipped: vec![("lab/broken".into(), "file is truncated".into())],
+            skipped: vec![
+                ("lab/broken".into(), "file is truncated".into()),
+                ("lab/bug".into(), "panicked: index out of bounds".into()),
+            ],
+            skipped_table: "dataset_quality/tables/skipped_sessions.md".into(),
             tables: vec![(
                 "Sessions".into(),
                 "dataset_quality/tables/sessions.md".into(),
@@ -139,6 +157,16 @@ mod tests {
             rustc: "rustc 1.95.0".into(),
             total_seconds: 1.5,
         };
-        insta::assert_snapshot!(render(&[run], &md, &h));
+        insta::assert_snapshot!(render(std::slice::from_ref(&run), &md, &h));
+        // a run without skips still says so, with its (empty) table
+        let clean = RunSummary {
+            skipped: Vec::new(),
+            ..run
+        };
+        let text = render(&[clean], &md, &h);
+        assert!(
+            text.contains("### Skipped sessions (0)\n\nNone: every session gave results.\n\nTable: [md](dataset_quality/tables/skipped_sessions.md)"),
+            "{text}"
+        );
     }
 }

@@ -1,7 +1,7 @@
 //! CLEAR MOT accumulation, frame by frame, as py-motmetrics 1.4.0 `MOTAccumulator.update`
 //! (with `max_switch_time = ∞`) and the counts of `metrics.py`.
 
-use super::Frame;
+use super::{Frame, Frames};
 use crate::assign::min_cost_max_pairs;
 
 /// An object is mostly tracked when matched in at least this share of its frames (Li et al.,
@@ -141,11 +141,12 @@ struct ObjectTally {
 }
 
 /// Run the accumulator over `frames` (ascending). `gt_ids` / `hyp_ids` map dense indices back
-/// to the input ids for the events.
+/// to the input ids for the events, which are collected only when `keep_events`.
 pub(super) fn accumulate(
-    frames: &[Frame],
+    frames: &dyn Frames,
     gt_ids: &[i64],
     hyp_ids: &[i64],
+    keep_events: bool,
 ) -> (ClearMot, Vec<Event>) {
     // motmetrics state: `m` (object → its last hypothesis), `res_m` (hypothesis → its last
     // object), `last_match` and `hypHistory` (only whether an entry exists is ever read).
@@ -155,10 +156,10 @@ pub(super) fn accumulate(
     let mut ever_matched_hyp = vec![false; hyp_ids.len()];
     let mut tally = vec![ObjectTally::default(); gt_ids.len()];
     let mut events = Vec::new();
-    let mut c = empty_counts(frames.len() as u64);
+    let mut c = empty_counts(frames.num_frames() as u64);
     let mut gt_done = Vec::new();
     let mut hyp_done = Vec::new();
-    for f in frames {
+    frames.each(&mut |f| {
         let (ng, nh) = (f.gt.len(), f.hyp.len());
         gt_done.clear();
         gt_done.resize(ng, false);
@@ -258,7 +259,10 @@ pub(super) fn accumulate(
         }
         c.num_objects += ng as u64;
         c.num_predictions += nh as u64;
-    }
+        if !keep_events {
+            events.clear();
+        }
+    });
     count_objects(&tally, &mut c);
     c.num_detections = c.num_matches + c.num_switches;
     (c.finish(), events)
@@ -352,7 +356,7 @@ mod tests {
 
     fn run(frames: &[Frame]) -> (ClearMot, Vec<Event>) {
         let ids: Vec<i64> = (0..10).collect();
-        accumulate(frames, &ids, &ids)
+        accumulate(&frames, &ids, &ids, true)
     }
 
     fn kinds(events: &[Event]) -> Vec<(i64, EventKind, Option<i64>, Option<i64>)> {

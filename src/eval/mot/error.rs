@@ -75,6 +75,8 @@ pub enum MotError {
     },
     #[error("{side} frame {frame} id {id}: a coordinate or the confidence is not finite")]
     NonFinite { side: Side, frame: i64, id: i64 },
+    #[error("{side}: more than 2³² − 1 observations")]
+    TooLarge { side: Side },
     #[error("{rule} threshold {value} is out of range: {allowed}")]
     BadThreshold {
         rule: &'static str,

@@ -18,7 +18,7 @@
 
 use std::collections::HashMap;
 
-use super::Frame;
+use super::Frames;
 use crate::assign::max_score_pairs;
 
 /// Number of localisation thresholds α.
@@ -136,9 +136,12 @@ impl Hota {
     }
 }
 
-pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> Hota {
-    let num_gt: usize = frames.iter().map(|f| f.gt.len()).sum();
-    let num_hyp: usize = frames.iter().map(|f| f.hyp.len()).sum();
+pub(super) fn compute(frames: &dyn Frames, n_gt: usize, n_hyp: usize) -> Hota {
+    let (mut num_gt, mut num_hyp) = (0usize, 0usize);
+    frames.each(&mut |f| {
+        num_gt += f.gt.len();
+        num_hyp += f.hyp.len();
+    });
     if num_gt == 0 || num_hyp == 0 {
         // TrackEval returns early: everything FN (or FP), LocA 1, the rest 0.
         let per_alpha = (0..HOTA_ALPHAS)
@@ -153,17 +156,17 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> Hota {
     }
 
     // 1. Global alignment A(g, t), for the pairs that ever overlap. Each such pair gets a
-    //    dense index; `entry_pair` holds it for every similarity entry of every frame.
+    //    dense index (`pair_of`); the second pass looks it up again for each overlapping
+    //    entry of its frame (`entries`), so no per-entry index is kept for the whole sequence.
     const NO_PAIR: u32 = u32::MAX;
     let mut pair_of: HashMap<(usize, usize), u32> = HashMap::new();
     let mut pairs: Vec<(usize, usize)> = Vec::new();
     let mut potential: Vec<f64> = Vec::new();
-    let mut entry_pair: Vec<u32> = Vec::with_capacity(frames.iter().map(|f| f.sim.len()).sum());
     let mut gt_count = vec![0u64; n_gt];
     let mut hyp_count = vec![0u64; n_hyp];
     let mut row_sum = Vec::new();
     let mut col_sum = Vec::new();
-    for f in frames {
+    frames.each(&mut |f| {
         let nh = f.hyp.len();
         let rows = || f.sim.chunks(nh.max(1)).take(f.gt.len());
         row_sum.clear();
@@ -179,7 +182,6 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> Hota {
             for (j, &t) in f.hyp.iter().enumerate() {
                 let s = f.sim[i * nh + j];
                 if s <= 0.0 {
-                    entry_pair.push(NO_PAIR);
                     continue;
                 }
                 let p = *pair_of.entry((g, t)).or_insert_with(|| {
@@ -187,7 +189,6 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> Hota {
                     potential.push(0.0);
                     (pairs.len() - 1) as u32
                 });
-                entry_pair.push(p);
                 let denom = col_sum[j] + row_sum[i] - s;
                 if denom > f64::EPSILON {
                     potential[p as usize] += s / denom;
@@ -200,7 +201,7 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> Hota {
         for &t in &f.hyp {
             hyp_count[t] += 1;
         }
-    }
+    });
     let alignment: Vec<f64> = pairs
         .iter()
         .zip(&potential)
@@ -211,17 +212,25 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> Hota {
     let mut per_alpha: Vec<HotaAtAlpha> = (0..HOTA_ALPHAS).map(HotaAtAlpha::zero).collect();
     let mut loc_sum = [0.0f64; HOTA_ALPHAS];
     let mut matches: Vec<Vec<u64>> = vec![vec![0; pairs.len()]; HOTA_ALPHAS];
-    let mut offset = 0;
-    for f in frames {
+    let mut entries: Vec<u32> = Vec::new();
+    frames.each(&mut |f| {
         let (ng, nh) = (f.gt.len(), f.hyp.len());
-        let entries = &entry_pair[offset..offset + ng * nh];
-        offset += ng * nh;
         if ng == 0 || nh == 0 {
             for a in per_alpha.iter_mut() {
                 a.num_fp += nh as u64;
                 a.num_fn += ng as u64;
             }
-            continue;
+            return;
+        }
+        entries.clear();
+        for (i, &g) in f.gt.iter().enumerate() {
+            for (j, &t) in f.hyp.iter().enumerate() {
+                entries.push(if f.sim[i * nh + j] > 0.0 {
+                    pair_of.get(&(g, t)).copied().unwrap_or(NO_PAIR)
+                } else {
+                    NO_PAIR
+                });
+            }
         }
         let assigned = max_score_pairs(ng, nh, |i, j| match entries[i * nh + j] {
             NO_PAIR => 0.0,
@@ -245,7 +254,7 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> Hota {
             a.num_fn += ng as u64 - n;
             a.num_fp += nh as u64 - n;
         }
-    }
+    });
 
     // Association scores per α, then the final fields.
     let per_alpha = per_alpha

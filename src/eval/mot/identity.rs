@@ -10,7 +10,7 @@
 
 use std::collections::HashMap;
 
-use super::Frame;
+use super::Frames;
 use crate::assign::max_count_pairs;
 
 /// IDF1 and its parts. Ratios are NaN where their denominator is zero.
@@ -53,10 +53,10 @@ impl IdMetrics {
     }
 }
 
-pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> IdMetrics {
+pub(super) fn compute(frames: &dyn Frames, n_gt: usize, n_hyp: usize) -> IdMetrics {
     let mut agree: HashMap<(usize, usize), u64> = HashMap::new();
     let (mut num_gt, mut num_hyp) = (0u64, 0u64);
-    for f in frames {
+    frames.each(&mut |f| {
         let nh = f.hyp.len();
         num_gt += f.gt.len() as u64;
         num_hyp += nh as u64;
@@ -67,7 +67,7 @@ pub(super) fn compute(frames: &[Frame], n_gt: usize, n_hyp: usize) -> IdMetrics 
                 }
             }
         }
-    }
+    });
     let mut edges: Vec<(usize, usize, u64)> = agree.iter().map(|(&(o, h), &n)| (o, h, n)).collect();
     // Sorted, so ties between equally good matchings break the same way on every run.
     edges.sort_unstable();

@@ -108,31 +108,33 @@ impl Sequence {
 }
 
 fn check_sequence(key: &str, s: &Sequence, out: &mut Vec<Invalid>) {
-    if s.scan_topic.is_empty() || s.gt_topic.is_empty() {
-        out.push((key.into(), "scan_topic and gt_topic must be set".into()));
+    for (field, topic) in [("scan_topic", &s.scan_topic), ("gt_topic", &s.gt_topic)] {
+        if topic.is_empty() {
+            out.push((format!("{key}.{field}"), "must be set".into()));
+        }
     }
     if let Some([a, b]) = s.scans
         && !(a >= 0 && a <= b)
     {
         out.push((
-            key.into(),
-            format!("scans [{a}, {b}] needs 0 ≤ first ≤ last"),
+            format!("{key}.scans"),
+            format!("[{a}, {b}] needs 0 ≤ first ≤ last"),
         ));
     }
     if let Some([lo, hi]) = s.wedge_deg
         && !(lo.is_finite() && hi.is_finite() && lo <= hi)
     {
         out.push((
-            key.into(),
-            format!("wedge_deg [{lo}, {hi}] needs min ≤ max"),
+            format!("{key}.wedge_deg"),
+            format!("[{lo}, {hi}] needs min ≤ max"),
         ));
     }
     if let Some(r) = s.max_range_m
         && !(r.is_finite() && r > 0.0)
     {
         out.push((
-            key.into(),
-            format!("max_range_m {r} must be finite and > 0"),
+            format!("{key}.max_range_m"),
+            format!("{r} must be finite and > 0"),
         ));
     }
 }
@@ -154,11 +156,17 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
     if !(p.level > 0.0 && p.level < 1.0) {
         out.push(("level".into(), format!("{} is not in (0, 1)", p.level)));
     }
-    for s in &p.sequences {
+    for (i, s) in p.sequences.iter().enumerate() {
+        let key = format!("sequences[{i}]");
         if s.name.is_empty() {
-            out.push(("sequences".into(), "every sequence needs a name".into()));
+            out.push((format!("{key}.name"), "every sequence needs a name".into()));
+        } else if p.sequences[..i].iter().any(|o| o.name == s.name) {
+            out.push((
+                format!("{key}.name"),
+                format!("`{}` is listed twice", s.name),
+            ));
         }
-        check_sequence("sequences", s, &mut out);
+        check_sequence(&key, s, &mut out);
     }
     check_sequence("synthetic", &p.synthetic, &mut out);
     if p.methods.is_empty() {
@@ -201,8 +209,22 @@ mod tests {
             ..Params::default()
         };
         p.synthetic.scans = Some([5, 2]);
+        p.sequences = vec![p.synthetic.clone(), p.synthetic.clone()];
+        p.sequences[0].name = "a".into();
+        p.sequences[0].scans = None;
+        p.sequences[1].name = "a".into();
+        p.sequences[1].scans = None;
+        p.sequences[1].wedge_deg = Some([10.0, -10.0]);
         let keys: Vec<String> = validate(&p).into_iter().map(|(k, _)| k).collect();
-        assert_eq!(keys, ["match_m", "synthetic"]);
+        assert_eq!(
+            keys,
+            [
+                "match_m",
+                "sequences[1].name",
+                "sequences[1].wedge_deg",
+                "synthetic.scans"
+            ]
+        );
         let p = Params {
             methods: vec![Method::Nearest, Method::Legs, Method::Nearest],
             ..Params::default()

@@ -19,6 +19,10 @@ pub fn split(seed: u64, fraction: f64, s: usize, idx: &[usize]) -> (Vec<usize>, 
     (v, test)
 }
 
+/// Fewest training frames a split may leave: from one frame min–max scaling maps every
+/// input to 0.5 and the network learns a constant.
+pub const MIN_TRAIN: usize = 2;
+
 /// Features and distances of the dataset with the protocol's parameters.
 pub struct Learner<'a> {
     pub xs: Vec<Vec<f64>>,
@@ -63,18 +67,38 @@ impl<'a> Learner<'a> {
     }
 
     /// A network fitted on `train` with the seeded stream `(seed, "net", label)`.
-    pub fn fit(&self, train: &[usize], label: u64, spec: TrainSpec) -> Regressor {
+    pub fn fit(&self, train: &[usize], label: u64, spec: TrainSpec) -> anyhow::Result<Regressor> {
         let tx: Vec<Vec<f64>> = train.iter().map(|i| self.xs[*i].clone()).collect();
         let ty: Vec<f64> = train.iter().map(|i| self.dist[*i]).collect();
-        Regressor::fit(&tx, &ty, spec, &mut rng::stream(self.seed, "net", label))
+        Regressor::fit(&tx, &ty, spec, &mut rng::stream(self.seed, "net", label)).map_err(|e| {
+            anyhow::anyhow!(
+                "training a network on {} frames: {e} (see params.train_fraction, params.epochs, params.hidden_units)",
+                train.len()
+            )
+        })
     }
 
     /// The loaded model, or the main protocol's network fitted on `train`.
-    pub fn model(&self, train: &[usize], label: u64) -> Regressor {
+    pub fn model(&self, train: &[usize], label: u64) -> anyhow::Result<Regressor> {
         match self.loaded {
-            Some(m) => m.clone(),
+            Some(m) => Ok(m.clone()),
             None => self.fit(train, label, self.spec),
         }
+    }
+
+    /// Check that `params.train_fraction` leaves at least [`MIN_TRAIN`] training frames and one
+    /// test frame of `n` frames (`what` names them in the error: "the 684 frames").
+    pub fn check_fraction(&self, n: usize, what: &str) -> anyhow::Result<()> {
+        let n_train = ((n as f64) * self.fraction).round() as usize;
+        if n_train < MIN_TRAIN || n_train >= n {
+            anyhow::bail!(
+                "params.train_fraction = {} splits {what} ({n}) into {n_train} training and {} test frames; \
+                 need at least {MIN_TRAIN} to train and 1 to test",
+                self.fraction,
+                n - n_train.min(n)
+            );
+        }
+        Ok(())
     }
 
     /// Absolute distance errors of `m` on the frames `idx`.
@@ -93,10 +117,10 @@ pub struct Split0 {
 }
 
 impl Split0 {
-    pub fn new(l: &Learner) -> Split0 {
+    pub fn new(l: &Learner) -> anyhow::Result<Split0> {
         let (train, test) = l.split(0, &l.all());
-        let model = l.model(&train, 0);
-        Split0 { train, test, model }
+        let model = l.model(&train, 0)?;
+        Ok(Split0 { train, test, model })
     }
 }
 

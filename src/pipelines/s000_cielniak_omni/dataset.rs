@@ -177,7 +177,8 @@ pub fn build(
         anyhow::bail!(
             "only {} frames have both omni features and a measured position; need at least 20 \
              ({with_person} of {} omni frames show a person, {measured} webcam frames see the hat in ≥ 2 cameras; \
-             no person in any omni frame usually means one stood in the first {} frames, which are taken as the empty background)",
+             no person in any omni frame usually means one stood in the first params.background_frames = {} frames, \
+             which are taken as the empty background, or that params.panorama / params.inner_radius do not fit the mirror)",
             rows.len(),
             inputs.omni.len(),
             background_frames

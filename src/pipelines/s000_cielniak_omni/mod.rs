@@ -127,7 +127,11 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     angle::run(&data.rows, &mut out)?;
 
     let learner = ann::Learner::new(&data, p, loaded.as_ref().map(|m| &m.regressor));
-    let split0 = ann::Split0::new(&learner);
+    learner.check_fraction(
+        data.rows.len(),
+        "the frames with features and a measured position",
+    )?;
+    let split0 = ann::Split0::new(&learner)?;
     splits::run(&learner, &data.rows, p, &mut out)?;
     correlations::run(&learner, &split0, &mut out)?;
     sweep::run(&learner, p, &mut out)?;
@@ -136,7 +140,7 @@ fn analyse(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     truth_check::run(&data, &tracked, &mut out)?;
 
     // the general model on all data (or the loaded one): per-frame estimates, and the artefact
-    let general = learner.model(&learner.all(), 400);
+    let general = learner.model(&learner.all(), 400)?;
     let trained_on = loaded.is_none().then_some(data.rows.len());
     estimates::run(ctx, p, general, trained_on, &mut out)?;
     Ok(out)

@@ -70,6 +70,14 @@ pub fn features_of(
         });
         Ok(())
     })?;
+    if background.is_none() {
+        anyhow::bail!(
+            "params.background_frames = {}: /{} has only {} image(s), none left after the background",
+            p.background_frames,
+            p.omni,
+            bg_frames.len()
+        );
+    }
     let pose = PoseRow {
         x: omni_pose.translation.x,
         y: omni_pose.translation.y,

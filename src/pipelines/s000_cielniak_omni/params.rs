@@ -80,41 +80,107 @@ impl Params {
     }
 }
 
+/// Largest panorama side (px): the paper's is 480 × 120; beyond this a frame's panorama alone
+/// takes hundreds of megabytes.
+pub const MAX_PANORAMA_PX: usize = 8192;
+
 /// Every problem with `p`, as (parameter, reason).
 pub fn validate(p: &Params) -> Vec<Invalid> {
-    let mut out = Vec::new();
+    let mut out: Vec<Invalid> = Vec::new();
+    let mut bad = |k: &str, r: String| out.push((k.to_string(), r));
     if !(p.train_fraction > 0.0 && p.train_fraction < 1.0) {
-        out.push((
-            "train_fraction".into(),
+        bad(
+            "train_fraction",
             format!("{} is not in (0, 1)", p.train_fraction),
-        ));
+        );
     }
     if p.webcams.len() == 1 || p.webcams.is_empty() && p.model.is_empty() {
-        out.push((
-            "webcams".into(),
+        bad(
+            "webcams",
             "the measurement system needs at least two cameras (or none, with `model` set, to only estimate positions)".into(),
-        ));
+        );
     }
-    if p.hidden_units == 0 || p.sweep_hidden.contains(&0) {
-        out.push((
-            "hidden_units".into(),
+    if p.hidden_units == 0 {
+        bad(
+            "hidden_units",
             "a network needs at least one hidden unit".into(),
-        ));
+        );
+    }
+    if p.sweep_hidden.contains(&0) {
+        bad(
+            "sweep_hidden",
+            "a network needs at least one hidden unit".into(),
+        );
     }
     if !(p.learning_rate > 0.0 && p.learning_rate < 10.0) {
-        out.push((
-            "learning_rate".into(),
+        bad(
+            "learning_rate",
             format!("{} is not in (0, 10)", p.learning_rate),
-        ));
+        );
+    }
+    if let Some(lr) = p
+        .sweep_learning_rates
+        .iter()
+        .find(|lr| !(**lr > 0.0 && **lr < 10.0))
+    {
+        bad("sweep_learning_rates", format!("{lr} is not in (0, 10)"));
+    }
+    for (key, n, what) in [
+        ("splits", p.splits, "random splits"),
+        (
+            "sweep_splits",
+            p.sweep_splits,
+            "random splits per sweep cell",
+        ),
+        (
+            "epochs",
+            p.epochs,
+            "epochs (0 leaves the network untrained)",
+        ),
+    ] {
+        if n == 0 {
+            bad(key, format!("needs at least 1 of {what}"));
+        }
     }
     if p.background_frames < 2 {
-        out.push((
-            "background_frames".into(),
+        bad(
+            "background_frames",
             "the background needs at least 2 frames".into(),
-        ));
+        );
+    }
+    let [w, h] = p.panorama;
+    if !(8..=MAX_PANORAMA_PX).contains(&w) || !(4..=MAX_PANORAMA_PX).contains(&h) {
+        bad(
+            "panorama",
+            format!(
+                "[{w}, {h}] is not a panorama size: width 8..={MAX_PANORAMA_PX}, height 4..={MAX_PANORAMA_PX} px (paper: [480, 120])"
+            ),
+        );
     }
     if !(p.inner_radius > 0.0 && p.inner_radius < 1.0) {
-        out.push(("inner_radius".into(), "must be a fraction in (0, 1)".into()));
+        bad("inner_radius", "must be a fraction in (0, 1)".into());
+    }
+    let [lo, hi] = p.hat_hue_deg;
+    if !(lo.is_finite() && hi.is_finite() && lo < hi && (0.0..=360.0).contains(&lo) && hi <= 360.0)
+    {
+        bad(
+            "hat_hue_deg",
+            format!("[{lo}, {hi}] is not a hue band in 0..=360 degrees"),
+        );
+    }
+    for (key, v) in [
+        ("hat_min_saturation", p.hat_min_saturation),
+        ("hat_min_value", p.hat_min_value),
+    ] {
+        if !(0.0..=1.0).contains(&v) {
+            bad(key, format!("{v} is not in [0, 1]"));
+        }
+    }
+    if !(p.max_gap_s > 0.0 && p.max_gap_s.is_finite()) {
+        bad(
+            "max_gap_s",
+            format!("{} is not a positive number of seconds", p.max_gap_s),
+        );
     }
     out
 }
@@ -148,10 +214,30 @@ mod tests {
             [
                 "train_fraction",
                 "webcams",
-                "hidden_units",
+                "sweep_hidden",
                 "learning_rate",
                 "background_frames",
                 "inner_radius"
+            ]
+        );
+        let bad = Params {
+            splits: 0,
+            sweep_splits: 0,
+            epochs: 0,
+            panorama: [480, 0],
+            hat_hue_deg: [150.0, 90.0],
+            max_gap_s: 0.0,
+            ..Params::default()
+        };
+        assert_eq!(
+            names(&bad),
+            [
+                "splits",
+                "sweep_splits",
+                "epochs",
+                "panorama",
+                "hat_hue_deg",
+                "max_gap_s"
             ]
         );
     }

@@ -69,13 +69,17 @@ pub fn run(l: &Learner, rows: &[Row], out: &mut Products) -> anyhow::Result<()> 
     let Some(pa) = two_persons(rows).filter(|_| l.loaded.is_none()) else {
         return Ok(());
     };
+    for pid in pa {
+        let n = rows.iter().filter(|r| r.person == pid).count();
+        l.check_fraction(n, &format!("person {pid}'s frames"))?;
+    }
     let splits = person_splits(l, rows, pa);
     let models: BTreeMap<i64, Regressor> = pa
         .iter()
-        .map(|pid| (*pid, l.fit(&splits[pid].0, 200 + *pid as u64, l.spec)))
-        .collect();
+        .map(|pid| Ok((*pid, l.fit(&splits[pid].0, 200 + *pid as u64, l.spec)?)))
+        .collect::<anyhow::Result<_>>()?;
     let union: Vec<usize> = pa.iter().flat_map(|pid| splits[pid].0.clone()).collect();
-    let general = l.fit(&union, 300, l.spec);
+    let general = l.fit(&union, 300, l.spec)?;
     let mut table = Vec::new();
     let (mut specific, mut generic) = (Vec::new(), Vec::new());
     for (a, subject) in pa.iter().enumerate() {

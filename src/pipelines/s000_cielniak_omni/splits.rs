@@ -50,24 +50,24 @@ pub fn best_and_worst(means: &[f64]) -> (usize, usize) {
 }
 
 /// Train and test on `p.splits` splits (in parallel, collected in order).
-pub fn per_split(l: &Learner, splits: usize) -> Vec<SplitErrors> {
+pub fn per_split(l: &Learner, splits: usize) -> anyhow::Result<Vec<SplitErrors>> {
     let all = l.all();
     (0..splits)
         .into_par_iter()
         .map(|s| {
             let (train, test) = l.split(s, &all);
-            let model = l.model(&train, s as u64);
+            let model = l.model(&train, s as u64)?;
             let e = l.errors(&model, &test);
-            SplitErrors {
+            Ok(SplitErrors {
                 split: s,
                 errors: test.into_iter().zip(e).collect(),
-            }
+            })
         })
         .collect()
 }
 
 pub fn run(l: &Learner, rows: &[Row], p: &Params, out: &mut Products) -> anyhow::Result<()> {
-    let per_split = per_split(l, p.splits);
+    let per_split = per_split(l, p.splits)?;
     let stats: Vec<(f64, f64)> = per_split
         .iter()
         .map(|s| mean_std(&s.errors.iter().map(|x| x.1).collect::<Vec<_>>()))

@@ -82,19 +82,18 @@ pub fn run(l: &Learner, p: &Params, out: &mut Products) -> anyhow::Result<()> {
                 learning_rate: lr,
                 epochs: p.epochs,
             };
-            let errs: Vec<f64> = (0..p.sweep_splits)
-                .flat_map(|s| {
-                    let (train, test) = l.split(s, &all);
-                    l.errors(&l.fit(&train, 1000 + s as u64, spec), &test)
-                })
-                .collect();
-            SweepRow {
+            let mut errs: Vec<f64> = Vec::new();
+            for s in 0..p.sweep_splits {
+                let (train, test) = l.split(s, &all);
+                errs.extend(l.errors(&l.fit(&train, 1000 + s as u64, spec)?, &test));
+            }
+            Ok(SweepRow {
                 hidden_units: h as i64,
                 learning_rate: lr,
                 mean_error_m: mean_std(&errs).0,
-            }
+            })
         })
-        .collect();
+        .collect::<anyhow::Result<_>>()?;
     out.figures.push(figure(&p.sweep_learning_rates, &results));
     if let Some(b) = best(&results) {
         out.summary.push(format!(

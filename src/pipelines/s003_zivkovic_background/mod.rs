@@ -69,6 +69,10 @@ impl Experiment for BackgroundTracking {
         params::validate(p)
     }
 
+    fn topic_keys(_: &Params) -> Vec<String> {
+        params::TOPIC_KEYS.iter().map(|k| k.to_string()).collect()
+    }
+
     fn plan(p: &Params, t: &BTreeMap<String, String>) -> Vec<Stage> {
         let tp = params::topics_of(p, t);
         vec![

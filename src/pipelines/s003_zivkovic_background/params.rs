@@ -8,8 +8,9 @@ use serde::{Deserialize, Serialize};
 use crate::groundtruth::PEOPLE_TOPIC;
 use crate::run::config::Invalid;
 use crate::vision::GmmParams;
-use crate::vision::colortrack::{ColorSpace, EmParams, MeanShiftParams};
-use crate::vision::local::LocalParams;
+use crate::vision::colortrack::{ColorSpace, ColorTrackError, EmParams, MeanShiftParams};
+use crate::vision::gmm::GmmError;
+use crate::vision::local::{LocalError, LocalParams};
 
 /// `[params.roc]`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -162,6 +163,9 @@ fn topic(topics: &BTreeMap<String, String>, logical: &str, default: String) -> S
     topics.get(logical).cloned().unwrap_or(default)
 }
 
+/// The logical topic names `[topics]` may remap.
+pub(super) const TOPIC_KEYS: [&str; 4] = ["image", "mask", "ground_truth", "odom"];
+
 /// The topics read, with `[topics]` remaps applied.
 pub(super) struct Topics {
     pub image: String,
@@ -179,50 +183,117 @@ pub(super) fn topics_of(p: &Params, t: &BTreeMap<String, String>) -> Topics {
     }
 }
 
-/// Every parameter problem, named.
+/// `(key path, reason)` of a GMM parameter error under `prefix` (e.g. `roc.adaptive`).
+fn gmm_problem(prefix: &str, e: &GmmError) -> Invalid {
+    match e {
+        GmmError::BadParam { name, value, why } => {
+            (format!("{prefix}.{name}"), format!("{value} {why}"))
+        }
+        other => (prefix.to_string(), other.to_string()),
+    }
+}
+
+/// `(key path, reason)` of a colour-tracker parameter error under `prefix`.
+fn colour_problem(prefix: &str, e: &ColorTrackError) -> Invalid {
+    match e {
+        ColorTrackError::BadParam { name, value, why } => {
+            (format!("{prefix}.{name}"), format!("{value} {why}"))
+        }
+        other => (prefix.to_string(), other.to_string()),
+    }
+}
+
+/// `(key path, reason)` of a local-tracking parameter error (`[params.local]` and its
+/// `gmm` / `em` tables).
+fn local_problem(e: &LocalError) -> Invalid {
+    match e {
+        LocalError::BadParam { name, value, why } => {
+            (format!("local.{name}"), format!("{value} {why}"))
+        }
+        LocalError::Gmm(g) => gmm_problem("local.gmm", g),
+        LocalError::Colour(c) => colour_problem("local.em", c),
+        other => ("local".into(), other.to_string()),
+    }
+}
+
+/// Every parameter problem, named by its key path below `[params]`.
 pub(super) fn validate(p: &Params) -> Vec<Invalid> {
-    let mut out = Vec::new();
+    let mut out: Vec<Invalid> = Vec::new();
+    let mut bad = |k: &str, r: String| out.push((k.to_string(), r));
     if p.roc.var_thresholds.is_empty()
         || p.roc
             .var_thresholds
             .iter()
             .any(|v| !(v.is_finite() && *v > 0.0))
     {
-        out.push(("var_thresholds".into(), "needs finite values > 0".into()));
+        bad("roc.var_thresholds", "needs finite values > 0".into());
     }
-    for (name, g) in [("adaptive", &p.roc.adaptive), ("baseline", &p.roc.baseline)] {
+    for (name, g) in [
+        ("roc.adaptive", &p.roc.adaptive),
+        ("roc.baseline", &p.roc.baseline),
+    ] {
         if let Err(e) = g.validate() {
-            out.push((name.into(), e.to_string()));
+            let (k, r) = gmm_problem(name, &e);
+            bad(&k, r);
         }
     }
     if let Err(e) = p.local.validate() {
-        out.push(("local".into(), e.to_string()));
+        let (k, r) = local_problem(&e);
+        bad(&k, r);
     }
     if let Err(e) = p.colour.em.validate() {
-        out.push(("em".into(), e.to_string()));
+        let (k, r) = colour_problem("colour.em", &e);
+        bad(&k, r);
     }
     if let Err(e) = p.colour.mean_shift.validate() {
-        out.push(("mean_shift".into(), e.to_string()));
+        let (k, r) = colour_problem("colour.mean_shift", &e);
+        bad(&k, r);
     }
     if let Some(beta) = p.colour.compare_beta
         && !(beta.is_finite() && beta > 0.0)
     {
-        out.push((
-            "compare_beta".into(),
+        bad(
+            "colour.compare_beta",
             format!("{beta} must be finite and positive"),
-        ));
+        );
     }
-    if !(0.0..=1.0).contains(&p.local_eval.min_iou) {
-        out.push((
-            "min_iou".into(),
-            format!("{} is not in [0, 1]", p.local_eval.min_iou),
-        ));
+    if p.colour.spaces.is_empty() {
+        bad("colour.spaces", "needs at least one colour space".into());
+    }
+    if let Some(h) = p.colour.person_height_m
+        && !(h.is_finite() && h > 0.0)
+    {
+        bad(
+            "colour.person_height_m",
+            format!("{h} must be finite and positive"),
+        );
+    }
+    for (key, v) in [
+        ("colour.min_visibility", p.colour.min_visibility),
+        ("local_eval.min_iou", p.local_eval.min_iou),
+        ("local_eval.min_visibility", p.local_eval.min_visibility),
+    ] {
+        if !(0.0..=1.0).contains(&v) {
+            bad(key, format!("{v} is not in [0, 1]"));
+        }
+    }
+    for (key, v) in [
+        ("colour.border_px", p.colour.border_px),
+        ("local_eval.moving_speed_mps", p.local_eval.moving_speed_mps),
+        (
+            "local_eval.moving_turn_rad_s",
+            p.local_eval.moving_turn_rad_s,
+        ),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            bad(key, format!("{v} must be finite and non-negative"));
+        }
     }
     if p.roc.fp_at_pct.iter().any(|v| !(0.0..=100.0).contains(v)) {
-        out.push((
-            "fp_at_pct".into(),
+        bad(
+            "roc.fp_at_pct",
             "values must be percentages in [0, 100]".into(),
-        ));
+        );
     }
     out
 }
@@ -248,11 +319,27 @@ mod tests {
         p.roc.fp_at_pct = vec![101.0];
         p.local_eval.min_iou = 1.5;
         p.colour.compare_beta = Some(f64::NAN);
+        p.roc.baseline.history = 0;
+        p.local.gmm.n_mixtures = 0;
+        p.local.em.beta = -1.0;
+        p.local.gate_sigma = f64::NAN;
         let names: Vec<String> = validate(&p).into_iter().map(|(n, _)| n).collect();
         assert_eq!(
             names,
-            ["var_thresholds", "compare_beta", "min_iou", "fp_at_pct"]
+            [
+                "roc.var_thresholds",
+                "roc.baseline.history",
+                "local.gmm.n_mixtures",
+                "colour.compare_beta",
+                "local_eval.min_iou",
+                "roc.fp_at_pct"
+            ]
         );
+        // the GMM and colour tracker of [params.local] are checked before its own keys
+        p.local.gmm.n_mixtures = 5;
+        assert!(validate(&p).iter().any(|(n, _)| n == "local.em.beta"));
+        p.local.em.beta = 1.1;
+        assert!(validate(&p).iter().any(|(n, _)| n == "local.gate_sigma"));
     }
 
     #[test]

@@ -90,6 +90,16 @@ impl Experiment for MulticamCylinders {
         params::validate(p)
     }
 
+    fn topic_keys(p: &Params) -> Vec<String> {
+        let mut keys: Vec<String> = p
+            .cameras
+            .iter()
+            .flat_map(|c| ["image", "info", "detections"].map(|k| format!("{c}_{k}")))
+            .collect();
+        keys.push("ground_truth".into());
+        keys
+    }
+
     fn plan(p: &Params, remap: &BTreeMap<String, String>) -> Vec<Stage> {
         let t = topics(p, remap);
         let mut stages = vec![Stage {

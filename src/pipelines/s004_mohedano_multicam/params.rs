@@ -204,12 +204,13 @@ pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
             format!("{} is not a fraction in (0, 1]", p.template_fill),
         );
     }
-    if p.template_scales == 0 || p.template_tilts == 0 || p.template_scales * p.template_tilts > 64
-    {
-        bad(
-            "template_scales",
-            "scales × tilts must be between 1 and 64".into(),
-        );
+    for (key, n) in [
+        ("template_scales", p.template_scales),
+        ("template_tilts", p.template_tilts),
+    ] {
+        if n == 0 || p.template_scales.saturating_mul(p.template_tilts) > 64 {
+            bad(key, "scales × tilts must be between 1 and 64".into());
+        }
     }
     if p.template_stride_px == 0 || p.template_stride_px > 16 {
         bad(
@@ -229,8 +230,34 @@ pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
             format!("{} is not a positive number of pixels", p.p_th_px),
         );
     }
-    if p.n_app == 0 || p.n_dis == 0 {
-        bad("n_app", "N_app and N_dis must be at least 1 frame".into());
+    for (key, n) in [("n_app", p.n_app), ("n_dis", p.n_dis)] {
+        if n == 0 {
+            bad(key, "N_app and N_dis must be at least 1 frame".into());
+        }
+    }
+    for (key, v) in [
+        ("match_iou_2d", p.match_iou_2d),
+        ("nms_iou", p.nms_iou),
+        ("nms_contained", p.nms_contained),
+    ] {
+        if !(0.0..=1.0).contains(&v) {
+            bad(key, format!("{v} is not in [0, 1]"));
+        }
+    }
+    if !(p.gate_m > 0.0 && p.gate_m.is_finite()) {
+        bad(
+            "gate_m",
+            format!("{} is not a positive distance in metres", p.gate_m),
+        );
+    }
+    if !(p.room_margin_m >= 0.0 && p.room_margin_m.is_finite()) {
+        bad(
+            "room_margin_m",
+            format!("{} is not a finite distance ≥ 0 m", p.room_margin_m),
+        );
+    }
+    if p.max_combinations == 0 {
+        bad("max_combinations", "must be at least 1".into());
     }
     if p.n_app_sweep.contains(&0) {
         bad("n_app_sweep", "values must be at least 1".into());
