@@ -1,0 +1,264 @@
+//! Logs from strangers (issue 19): hostile schemas and payloads give a clear error naming the
+//! file, topic and schema — never a stack overflow, a wrapped length or gigabytes of memory —
+//! and indexes that lie never hide or reorder messages. Every log here is crafted by the test.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+use common::raw_mcap as raw;
+use peopletrack::Nanos;
+use peopletrack::log::{Decoders, LogError, SessionLog, SessionWriter, WriterOptions};
+
+/// Open, read every message and decode it; the messages' `(topic, log time)`, or the first
+/// error.
+fn read_everything(path: &Path) -> Result<Vec<(String, u64)>, LogError> {
+    let log = SessionLog::open(path)?;
+    let mut dec = Decoders::new();
+    let mut seen = Vec::new();
+    for m in log.messages()? {
+        let m = m?;
+        dec.value(&log, &m)?;
+        seen.push((m.topic().to_string(), m.log_time.0));
+    }
+    Ok(seen)
+}
+
+fn peopletrack() -> Command {
+    Command::cargo_bin("peopletrack").expect("binary built")
+}
+
+/// A log with one message on `/x` of ROS 2 type `p/msg/T0` with schema `text`.
+fn one_message_log(dir: &Path, name: &str, text: &str, payload: &[u8]) -> PathBuf {
+    let p = dir.join(name);
+    let mut w = SessionWriter::create(&p, &WriterOptions::default()).expect("create");
+    let ch = w
+        .add_raw("/x", Some(("p/msg/T0", "ros2msg", text.as_bytes())), "cdr")
+        .expect("channel");
+    w.write_bytes(ch, Nanos(5_000_000_000), payload)
+        .expect("write");
+    w.finish().expect("finish")
+}
+
+/// `p/T0` holds a `p/T1`, ..., `p/T{depth-1}` holds an `int8`: `depth` nested types.
+fn nested_schema(depth: usize) -> String {
+    let mut text = String::new();
+    for i in 0..depth {
+        if i > 0 {
+            text.push_str(&format!("===\nMSG: p/T{i}\n"));
+        }
+        if i + 1 < depth {
+            text.push_str(&format!("p/T{} inner\n", i + 1));
+        } else {
+            text.push_str("int8 leaf\n");
+        }
+    }
+    text
+}
+
+/// Run `cat` and `inspect` on `log`: both must fail with exit status 1 (an error, not an
+/// abort) and say every `needle` on stderr.
+fn cli_fails_clearly(log: &Path, needles: &[&str]) {
+    for args in [vec!["cat", "--topic", "/x"], vec!["inspect"]] {
+        let out = peopletrack()
+            .args(&args)
+            .arg(log)
+            .output()
+            .expect("runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        if args[0] == "inspect" {
+            // inspect reports an undecodable channel in its table rather than failing
+            let text = format!("{stdout}{stderr}");
+            for n in needles {
+                assert!(text.contains(n), "inspect: `{n}` missing from: {text}");
+            }
+            continue;
+        }
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        for n in needles {
+            assert!(stderr.contains(n), "{args:?}: `{n}` missing from: {stderr}");
+        }
+    }
+}
+
+#[test]
+fn schema_nested_ten_thousand_deep_is_an_error_in_cat_and_inspect_not_a_stack_overflow() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = one_message_log(dir.path(), "deep.mcap", &nested_schema(10_000), &raw::cdr(&[7]));
+    let msg = read_everything(&p).expect_err("too deep").to_string();
+    for needle in ["deep.mcap", "/x", "p/msg/T0", "nest more than 64"] {
+        assert!(msg.contains(needle), "`{needle}` missing from: {msg}");
+    }
+    cli_fails_clearly(&p, &["deep.mcap", "nest more than 64"]);
+}
+
+#[test]
+fn schema_nested_two_thousand_deep_fails_inside_a_worker_thread_without_aborting() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = one_message_log(dir.path(), "deep.mcap", &nested_schema(2_000), &raw::cdr(&[7]));
+    // a pipeline worker: a spawned thread with the default stack
+    let result = std::thread::spawn(move || read_everything(&p).map_err(|e| e.to_string()))
+        .join()
+        .expect("the worker returns instead of aborting");
+    assert!(result.expect_err("too deep").contains("nest more than 64"));
+}
+
+#[test]
+fn nesting_at_the_limit_decodes_prints_and_drops_in_a_worker_thread() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let ok = one_message_log(dir.path(), "ok.mcap", &nested_schema(64), &raw::cdr(&[7]));
+    let over = one_message_log(dir.path(), "over.mcap", &nested_schema(65), &raw::cdr(&[7]));
+    let printed = std::thread::spawn(move || {
+        let log = SessionLog::open(&ok).expect("opens");
+        let m = log.messages().expect("stream").next().expect("one").expect("reads");
+        let v = Decoders::new().value(&log, &m).expect("64 levels decode");
+        v.to_json(None).to_string()
+    })
+    .join()
+    .expect("no stack overflow at the limit");
+    assert_eq!(
+        printed,
+        format!("{}{{\"leaf\":7}}{}", "{\"inner\":".repeat(63), "}".repeat(63))
+    );
+    let msg = read_everything(&over).expect_err("65 levels").to_string();
+    assert!(msg.contains("p/msg/T0") && msg.contains("nest more than 64"), "{msg}");
+}
+
+#[test]
+fn fixed_array_whose_byte_length_overflows_is_an_error_not_one_wrapped_element() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // 2305843009213693953 * 8 = 2^64 + 8: it used to wrap to 8 bytes and print {"x":[42.0]}
+    let p = one_message_log(
+        dir.path(),
+        "wrap.mcap",
+        "float64[2305843009213693953] x\n",
+        &raw::cdr(&42.0f64.to_le_bytes()),
+    );
+    let msg = read_everything(&p).expect_err("overflow").to_string();
+    for needle in ["wrap.mcap", "/x", "p/msg/T0", "2305843009213693953", "`x`"] {
+        assert!(msg.contains(needle), "`{needle}` missing from: {msg}");
+    }
+    let out = peopletrack()
+        .args(["cat", "--topic", "/x"])
+        .arg(&p)
+        .output()
+        .expect("runs");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(out.stdout.is_empty(), "nothing printed");
+    let out = peopletrack().arg("inspect").arg(&p).output().expect("runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(!text.contains(" ok"), "inspect must not call it ok: {text}");
+}
+
+#[test]
+fn long_fixed_arrays_and_sequences_are_bounded_by_the_bytes_left() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let check = |name: &str, text: &str, body: &[u8], needle: &str| {
+        let p = one_message_log(dir.path(), name, text, &raw::cdr(body));
+        let msg = read_everything(&p).expect_err(name).to_string();
+        assert!(msg.contains(needle) && msg.contains(name), "{name}: {msg}");
+    };
+    // 10^12 empty messages: each takes its one dummy byte, and 4 bytes are left
+    check(
+        "empty.mcap",
+        "p/E[1000000000000] e\n===\nMSG: p/E\n",
+        &[1, 2, 3, 4],
+        "1000000000000 at byte 4 cannot fit in the 4 bytes left",
+    );
+    // 10^12 messages of zero-length arrays take no bytes at all: capped outright
+    check(
+        "zero.mcap",
+        "p/Z[1000000000000] z\n===\nMSG: p/Z\nuint8[0] nothing\n",
+        &[],
+        "1000000000000 elements of a type that takes no bytes on the wire",
+    );
+    // a sequence of 2^31 float64s in a 12-byte payload
+    check(
+        "seq.mcap",
+        "float64[] v\n",
+        &[0, 0, 0, 0x80, 1, 2, 3, 4, 5, 6, 7, 8],
+        "2147483648 at byte 8 cannot fit in the 8 bytes left",
+    );
+    // 8 Mi one-byte messages: 8 MiB of payload would take ~800 MB as a tree
+    let mut body = (8u32 << 20).to_le_bytes().to_vec();
+    body.resize(4 + (8 << 20), 1);
+    check(
+        "bytes.mcap",
+        "p/B[] items\n===\nMSG: p/B\nuint8 v\n",
+        &body,
+        "bytes of structure",
+    );
+    // ... while a zero-length array of zero-size messages and 65,536 of them are fine
+    let p = one_message_log(
+        dir.path(),
+        "fine.mcap",
+        "p/Z[65536] z\nuint8 tail\n===\nMSG: p/Z\nuint8[0] nothing\n",
+        &raw::cdr(&[9]),
+    );
+    assert_eq!(read_everything(&p).expect("fine").len(), 1);
+}
+
+/// A `FileDescriptorSet` of `message t.Node { t.Node child = 1; int32 v = 2; }` (proto3).
+fn recursive_descriptor_set() -> Vec<u8> {
+    use prost_reflect::prost::Message as _;
+    use prost_reflect::prost_types::{
+        DescriptorProto, FieldDescriptorProto, FileDescriptorProto, FileDescriptorSet,
+        field_descriptor_proto::{Label, Type},
+    };
+    let field = |name: &str, number: i32, ty: Type, type_name: Option<&str>| FieldDescriptorProto {
+        name: Some(name.into()),
+        number: Some(number),
+        label: Some(Label::Optional as i32),
+        r#type: Some(ty as i32),
+        type_name: type_name.map(Into::into),
+        ..Default::default()
+    };
+    FileDescriptorSet {
+        file: vec![FileDescriptorProto {
+            name: Some("node.proto".into()),
+            package: Some("t".into()),
+            syntax: Some("proto3".into()),
+            message_type: vec![DescriptorProto {
+                name: Some("Node".into()),
+                field: vec![
+                    field("child", 1, Type::Message, Some(".t.Node")),
+                    field("v", 2, Type::Int32, None),
+                ],
+                ..Default::default()
+            }],
+            ..Default::default()
+        }],
+    }
+    .encode_to_vec()
+}
+
+#[test]
+fn recursive_protobuf_type_reads_unset_children_as_empty_instead_of_recursing_forever() {
+    use peopletrack::log::protobuf;
+    let desc = protobuf::descriptor("t.Node", &recursive_descriptor_set()).expect("descriptor");
+    // nothing set: the unset child used to expand its own default child, without end
+    let v = protobuf::decode(&desc, &[]).expect("decodes");
+    assert_eq!(v.to_json(None).to_string(), r#"{"child":{},"v":0}"#);
+    // child { child { v: 3 } }: set levels are kept, the unset one below is empty
+    let payload = [0x0a, 0x04, 0x0a, 0x02, 0x10, 0x03];
+    let v = protobuf::decode(&desc, &payload).expect("decodes");
+    assert_eq!(
+        v.to_json(None).to_string(),
+        r#"{"child":{"child":{"child":{},"v":3},"v":0},"v":0}"#
+    );
+    // 90 set levels: within prost's limit of 100, over ours of 64
+    let mut deep = vec![0x10, 0x01];
+    for _ in 0..90 {
+        let mut outer = vec![0x0a, deep.len() as u8];
+        if deep.len() >= 0x80 {
+            // two-byte varint length
+            outer = vec![0x0a, (deep.len() as u8 & 0x7f) | 0x80, (deep.len() >> 7) as u8];
+        }
+        outer.extend(deep);
+        deep = outer;
+    }
+    let e = protobuf::decode(&desc, &deep).expect_err("too deep");
+    assert!(e.contains("nests more than 64 deep"), "{e}");
+}
