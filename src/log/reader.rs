@@ -3,13 +3,15 @@
 //! thin shell that opens the file and feeds them.
 //!
 //! - `records`: pure record parsing over `&[u8]` — opcodes, explicit bounds checks (not
-//!   `binrw`), so a corrupt length gives an error but never a huge allocation or a panic;
-//!   chunk decompression and CRCs (rosbags writes 0 = not computed).
+//!   `binrw`), so a corrupt length gives an error but never a huge allocation or a panic.
+//! - `chunk`: chunk decompression as a stream that keeps only the wanted records, and CRCs
+//!   (rosbags writes 0 = not computed).
 //! - `index`: what opening learns — the summary section, or one linear pass without one.
 //! - `merge`: the time-ordered k-way merge of chunks behind [`MessageStream`]; chunks are
 //!   decompressed lazily and freed when consumed, equal log times keep file order.
 //! - `io`: bounded reads at an offset.
 
+mod chunk;
 mod index;
 mod io;
 mod merge;

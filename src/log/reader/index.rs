@@ -14,10 +14,11 @@ use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::sync::Arc;
 
 use super::super::error::LogErrorKind;
+use super::chunk::{Keep, open_chunk_keeping};
 use super::io::read_at;
 use super::records::{
     ChannelInfo, ChunkInfo, Cursor, MAGIC, MetadataRecord, RECORD_HEAD_LEN, SchemaInfo, Statistics,
-    add_channel, bad, op, open_chunk, parse_channel, parse_chunk_index, parse_message_header,
+    add_channel, bad, op, parse_channel, parse_chunk_index, parse_message_header,
     parse_metadata, parse_schema, parse_statistics, record_head, record_name, records,
 };
 use crate::time::Nanos;
@@ -330,7 +331,9 @@ impl LinearIndex {
 
     /// Index a chunk: decompress it once, register its schemas and channels, count messages.
     fn chunk(&mut self, body: &[u8], pos: u64, len: u64) -> Result<(), LogErrorKind> {
-        let chunk = open_chunk(body, pos, &self.summary.channels, None)?;
+        // only the messages' headers are kept: the pass needs channels and times
+        let chunk =
+            open_chunk_keeping(body, pos, &self.summary.channels, None, &mut |_| Keep::Header)?;
         let mut ids = BTreeSet::new();
         for rec in records(&chunk.data) {
             let (op_in, b, _) = rec.map_err(bad("chunk", pos))?;

@@ -20,10 +20,10 @@ use std::sync::Arc;
 use super::super::error::{LogError, LogErrorKind};
 use super::index::LogSummary;
 use super::io::read_at;
+use super::chunk::{Keep, open_chunk_keeping};
 use super::records::{
     ChannelInfo, ChunkInfo, MESSAGE_HEADER_LEN, RECORD_HEAD_LEN, SchemaInfo, add_channel, bad, op,
-    open_chunk, parse_channel, parse_message_header, parse_schema, record_head, record_name,
-    records,
+    parse_channel, parse_message_header, parse_schema, record_head, record_name, records,
 };
 use crate::time::Nanos;
 
@@ -91,7 +91,22 @@ impl Catalog {
     /// Decompress a chunk body, register its schemas/channels, and index its wanted messages.
     fn load(&mut self, body: &[u8], chunk: &ChunkInfo) -> Result<Slot, LogErrorKind> {
         let chunk_offset = chunk.offset;
-        let opened = open_chunk(body, chunk_offset, &self.channels, chunk.channels.as_ref())?;
+        // a channel defined inside this chunk is not known yet: keep its messages, the loop
+        // below filters them
+        let mut keep = |ch: u16| {
+            if self.topics.is_none() || !self.channels.contains_key(&ch) || self.wants(ch) {
+                Keep::Whole
+            } else {
+                Keep::Skip
+            }
+        };
+        let opened = open_chunk_keeping(
+            body,
+            chunk_offset,
+            &self.channels,
+            chunk.channels.as_ref(),
+            &mut keep,
+        )?;
         let (start, end) = (opened.start, opened.end);
         if chunk.length > 0 && (start, end) != (chunk.start, chunk.end) {
             return Err(LogErrorKind::BadRecord {
@@ -185,8 +200,15 @@ impl Catalog {
     }
 }
 
+/// Most bytes of wanted messages held at once from chunks that overlap in time: beyond it a
+/// log is refused with an error rather than exhausting memory. 1 GiB is some forty 4K RGB
+/// images in flight; real logs hold a chunk or two (a few MiB) at a time.
+const MAX_HELD_BYTES: usize = 1 << 30;
+
 /// The k-way merge of indexed chunks by log time.
 struct ChunkMerge {
+    /// Bytes of the loaded chunks' kept records.
+    held: usize,
     /// Chunks not loaded yet, latest start time first (popped from the back).
     pending: Vec<ChunkInfo>,
     slots: Vec<Option<Slot>>,
@@ -199,6 +221,7 @@ impl ChunkMerge {
         pending.sort_by_key(|c| (c.start, c.offset));
         pending.reverse(); // pop from the back
         ChunkMerge {
+            held: 0,
             pending,
             slots: Vec::new(),
             heap: BinaryHeap::new(),
@@ -227,6 +250,7 @@ impl ChunkMerge {
                 }
             };
             self.heap.push(Reverse((t, slot.chunk_offset, at, i)));
+            self.held += slot.buf.len();
             self.slots[i] = Some(slot);
         }
     }
@@ -242,6 +266,7 @@ impl ChunkMerge {
         if let Some(&(t, next_at)) = slot.entries.get(slot.next) {
             self.heap.push(Reverse((t, chunk_offset, next_at, i)));
         } else {
+            self.held -= slot.buf.len();
             self.slots[i] = None; // last message of the chunk: free it once the caller drops it
         }
         Some((buf, at, chunk_offset))
@@ -342,6 +367,16 @@ impl Indexed {
             )?;
             let slot = catalog.load(chunk_body(&rec, &chunk)?, &chunk)?;
             self.merge.insert(slot);
+            if self.merge.held > MAX_HELD_BYTES {
+                return Err(LogErrorKind::BadRecord {
+                    record: "chunk",
+                    offset: chunk.offset,
+                    reason: format!(
+                        "chunks overlapping in time up to {} s hold {} bytes of messages at                          once, more than the {MAX_HELD_BYTES} byte budget",
+                        chunk.end, self.merge.held
+                    ),
+                });
+            }
         }
         match self.merge.pop() {
             Some((buf, at, chunk_offset)) => catalog
