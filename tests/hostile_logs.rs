@@ -262,3 +262,141 @@ fn recursive_protobuf_type_reads_unset_children_as_empty_instead_of_recursing_fo
     let e = protobuf::decode(&desc, &deep).expect_err("too deep");
     assert!(e.contains("nests more than 64 deep"), "{e}");
 }
+
+/// `/x` (JSON, channel 1) messages at `times`, as top-level records.
+fn json_messages(times: &[u64]) -> Vec<u8> {
+    times
+        .iter()
+        .enumerate()
+        .flat_map(|(i, t)| raw::message(1, i as u32, *t, b"{}"))
+        .collect()
+}
+
+fn log_times(seen: &[(String, u64)]) -> Vec<u64> {
+    seen.iter().map(|(_, t)| *t).collect()
+}
+
+#[test]
+fn message_before_its_chunks_declared_start_is_never_delivered_out_of_order() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let channel = raw::channel(1, 0, "/x", "json");
+    // chunk A says 0..30 and holds 0, 30; chunk B says 40..100 but holds 20, 100
+    let a = raw::chunk(0, 30, &json_messages(&[0, 30]), true);
+    let b = raw::chunk(40, 100, &json_messages(&[20, 100]), true);
+    let a_at = 8 + raw::header().len() as u64 + channel.len() as u64;
+    let b_at = a_at + a.len() as u64;
+    let indexed = raw::file(
+        &[&channel, &a, &b],
+        &[
+            &channel,
+            &raw::chunk_index(0, 30, a_at, a.len() as u64, &[1]),
+            &raw::chunk_index(40, 100, b_at, b.len() as u64, &[1]),
+            &raw::statistics(4, 2, 0, 100),
+        ],
+    );
+    let p = dir.path().join("lying_index.mcap");
+    std::fs::write(&p, &indexed).expect("write");
+    // it used to print 0, 30, 20, 100 with exit 0
+    let msg = read_everything(&p).expect_err("order cannot be kept").to_string();
+    for needle in [
+        "lying_index.mcap",
+        &format!("chunk at byte {b_at}"),
+        "0.000000040 s",
+        "0.000000020 s",
+        "lies",
+    ] {
+        assert!(msg.contains(needle), "`{needle}` missing from: {msg}");
+    }
+    // without the summary the linear pass learns each chunk's real range: right order
+    let p = dir.path().join("lying_header.mcap");
+    std::fs::write(&p, raw::file(&[&channel, &a, &b], &[])).expect("write");
+    assert_eq!(
+        log_times(&read_everything(&p).expect("reads")),
+        [0, 20, 30, 100]
+    );
+    let log = SessionLog::open(&p).expect("opens");
+    assert_eq!(
+        log.summary().warnings,
+        [format!(
+            "chunk at byte {b_at} declares 0.000000040..0.000000100 s, its messages lie in \
+             0.000000020..0.000000100 s"
+        )]
+    );
+}
+
+#[test]
+fn statistics_of_zero_messages_without_a_chunk_index_fall_back_to_a_linear_scan() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let channel = raw::channel(1, 0, "/x", "json");
+    let chunk = raw::chunk(10, 50, &json_messages(&[10, 20, 30, 40, 50]), true);
+    let p = dir.path().join("zero_stats.mcap");
+    std::fs::write(
+        &p,
+        raw::file(&[&channel, &chunk], &[&channel, &raw::statistics(0, 0, 0, 0)]),
+    )
+    .expect("write");
+    // it used to say `messages: 0` and print nothing
+    assert_eq!(
+        log_times(&read_everything(&p).expect("reads")),
+        [10, 20, 30, 40, 50]
+    );
+    let log = SessionLog::open(&p).expect("opens");
+    assert_eq!(
+        log.summary().warnings,
+        ["the summary section says 0 messages and has no chunk index; a linear scan of the \
+          data found 5, and the index was rebuilt from the data"]
+    );
+    let out = peopletrack().arg("inspect").arg(&p).output().expect("runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("messages:  5\n"), "{text}");
+    assert!(text.contains("warning:   the summary section says 0 messages"), "{text}");
+    let out = peopletrack()
+        .args(["cat", "--topic", "/x"])
+        .arg(&p)
+        .output()
+        .expect("runs");
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 5);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("linear scan"));
+    // a log that really is empty stays empty, without a warning
+    let p = dir.path().join("empty.mcap");
+    std::fs::write(&p, raw::file(&[&channel], &[&channel, &raw::statistics(0, 0, 0, 0)]))
+        .expect("write");
+    assert!(read_everything(&p).expect("reads").is_empty());
+    assert!(SessionLog::open(&p).expect("opens").summary().warnings.is_empty());
+}
+
+#[test]
+fn inspect_says_when_a_log_carries_no_crcs() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let channel = raw::channel(1, 0, "/x", "json");
+    let inspect = |name: &str, chunks: &[&[u8]]| {
+        let p = dir.path().join(name);
+        let mut data: Vec<&[u8]> = vec![&channel];
+        data.extend_from_slice(chunks);
+        std::fs::write(&p, raw::file(&data, &[])).expect("write");
+        let crc = SessionLog::open(&p).expect("opens").crc_coverage().expect("crc");
+        let out = peopletrack().arg("inspect").arg(&p).output().expect("runs");
+        (crc, String::from_utf8_lossy(&out.stdout).into_owned())
+    };
+    // rosbags writes chunk CRC 0 ("not computed")
+    let no_crc = raw::chunk(1, 2, &json_messages(&[1, 2]), false);
+    let crc = raw::chunk(3, 4, &json_messages(&[3, 4]), true);
+    let (c, text) = inspect("rosbags.mcap", &[&no_crc, &no_crc]);
+    assert_eq!((c.chunks, c.with_crc, c.incomplete()), (2, 0, true));
+    assert!(
+        text.contains(
+            "crc:       none of the 2 chunks carries a CRC (0 = not computed): corruption \
+             cannot be detected"
+        ),
+        "{text}"
+    );
+    let (c, text) = inspect("mixed.mcap", &[&crc, &no_crc]);
+    assert_eq!((c.with_crc, c.incomplete()), (1, true));
+    assert!(text.contains("1 of 2 chunks carry no CRC"), "{text}");
+    let (c, text) = inspect("checked.mcap", &[&crc]);
+    assert!(!c.incomplete());
+    assert!(text.contains("crc:       all 1 chunks carry a CRC"), "{text}");
+    let (c, text) = inspect("loose.mcap", &[&json_messages(&[5])]);
+    assert!(c.incomplete());
+    assert!(text.contains("messages outside chunks carry no CRC"), "{text}");
+}

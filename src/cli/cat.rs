@@ -27,6 +27,9 @@ pub struct Args {
 
 pub fn run(args: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     let log = SessionLog::open(&args.log)?;
+    for w in &log.summary().warnings {
+        eprintln!("warning: {}: {w}", args.log.display());
+    }
     let mut decoders = Decoders::new();
     let limit = args.limit.unwrap_or(usize::MAX);
     for m in log.messages_on(&[args.topic.as_str()])?.take(limit) {

@@ -66,6 +66,15 @@ pub enum LogErrorKind {
         "messages are not in log-time order ({previous} s, then {this} s) and the file has no chunk index to sort them by; rewrite it with `mcap sort` or `mcap recover`"
     )]
     NotTimeOrdered { previous: Nanos, this: Nanos },
+    #[error(
+        "chunk at byte {offset} declares its messages start at {start} s but holds one at {this} s, before messages already read at {previous} s: the chunk index lies, so log-time order cannot be kept; rewrite the file with `mcap sort`"
+    )]
+    ChunkStartsEarlier {
+        offset: u64,
+        start: Nanos,
+        this: Nanos,
+        previous: Nanos,
+    },
     #[error("schema `{schema}` does not parse: {source}")]
     Schema { schema: String, source: SchemaError },
     #[error("{0}")]

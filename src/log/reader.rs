@@ -28,6 +28,46 @@ pub use index::LogSummary;
 pub use merge::{Message, MessageStream, Payload};
 pub use records::{ChannelInfo, ChunkInfo, MetadataRecord, SchemaInfo, Statistics};
 
+/// How many of a log's chunks carry a CRC.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CrcCoverage {
+    pub chunks: usize,
+    pub with_crc: usize,
+    /// Messages outside chunks carry no CRC at all.
+    pub unchunked_messages: bool,
+}
+
+impl CrcCoverage {
+    /// One line for `inspect`: whether corruption can be detected.
+    pub fn describe(&self) -> String {
+        let mut s = if self.chunks == 0 {
+            "no chunks".to_string()
+        } else if self.with_crc == self.chunks {
+            format!("all {} chunks carry a CRC", self.chunks)
+        } else if self.with_crc == 0 {
+            format!(
+                "none of the {} chunks carries a CRC (0 = not computed): corruption cannot be detected",
+                self.chunks
+            )
+        } else {
+            format!(
+                "{} of {} chunks carry no CRC: corruption in them cannot be detected",
+                self.chunks - self.with_crc,
+                self.chunks
+            )
+        };
+        if self.unchunked_messages {
+            s.push_str("; messages outside chunks carry no CRC: corruption cannot be detected");
+        }
+        s
+    }
+
+    /// True when some data cannot be checked for corruption.
+    pub fn incomplete(&self) -> bool {
+        self.with_crc < self.chunks || self.unchunked_messages
+    }
+}
+
 /// An open session log. Cheap to share; each [`SessionLog::messages`] call opens its own
 /// file handle.
 #[derive(Debug, Clone)]
@@ -49,7 +89,21 @@ impl SessionLog {
         }
         let summary = match index::read_summary_section(&mut file, file_len).map_err(err)? {
             Some(s) if index::summary_is_complete(&s) => s,
-            _ => index::linear_index(&mut file, file_len).map_err(err)?,
+            Some(claimed) => {
+                // no chunk index: the statistics alone are not believed over the data
+                let mut found = index::linear_index(&mut file, file_len).map_err(err)?;
+                let count = |s: &LogSummary| s.statistics.as_ref().map_or(0, |st| st.message_count);
+                if count(&claimed) != count(&found) {
+                    found.warnings.push(format!(
+                        "the summary section says {} messages and has no chunk index; a linear \
+                         scan of the data found {}, and the index was rebuilt from the data",
+                        count(&claimed),
+                        count(&found)
+                    ));
+                }
+                found
+            }
+            None => index::linear_index(&mut file, file_len).map_err(err)?,
         };
         Ok(SessionLog { path, summary })
     }
@@ -60,6 +114,27 @@ impl SessionLog {
 
     pub fn summary(&self) -> &LogSummary {
         &self.summary
+    }
+
+    /// Whether the log can detect corruption: of its chunks, how many carry a CRC (rosbags
+    /// writes 0 = "not computed"). Reads each chunk's fixed header only.
+    pub fn crc_coverage(&self) -> Result<CrcCoverage, LogError> {
+        let err = |k: LogErrorKind| LogError::new(&self.path, k);
+        let mut file = File::open(&self.path).map_err(|e| err(e.into()))?;
+        let mut out = CrcCoverage {
+            chunks: self.summary.chunks.len(),
+            with_crc: 0,
+            unchunked_messages: self.summary.unchunked_messages,
+        };
+        for c in &self.summary.chunks {
+            // opcode + length, then start, end, uncompressed size (u64 each) and the CRC
+            let head = io::read_at(&mut file, c.offset, 9 + 28, self.summary.file_len, "chunk")
+                .map_err(err)?;
+            if head[9 + 24..9 + 28] != [0, 0, 0, 0] {
+                out.with_crc += 1;
+            }
+        }
+        Ok(out)
     }
 
     /// Every message, in log-time order.

@@ -38,6 +38,8 @@ pub struct LogSummary {
     /// True if some messages are stored outside chunks.
     pub unchunked_messages: bool,
     pub file_len: u64,
+    /// Where the file's own index disagreed with its data (and the data was believed).
+    pub warnings: Vec<String>,
 }
 
 impl LogSummary {
@@ -57,15 +59,11 @@ impl LogSummary {
     }
 }
 
-/// A summary is usable if it indexes the chunks, or says the messages are outside chunks (read
-/// in file order), or says there are none. Without statistics and chunk indexes it tells too
-/// little, and the index is rebuilt by a linear pass.
+/// A summary is usable if it indexes the chunks or says the messages are outside chunks (read
+/// in file order). Without chunk indexes and with statistics of no messages it may be true
+/// (an empty log) or a lie hiding the data; a linear pass over the (then small) file tells.
 pub(super) fn summary_is_complete(s: &LogSummary) -> bool {
-    s.unchunked_messages
-        || !s.chunks.is_empty()
-        || s.statistics
-            .as_ref()
-            .is_some_and(|st| st.message_count == 0)
+    s.unchunked_messages || !s.chunks.is_empty()
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -335,6 +333,7 @@ impl LinearIndex {
         let chunk =
             open_chunk_keeping(body, pos, &self.summary.channels, None, &mut |_| Keep::Header)?;
         let mut ids = BTreeSet::new();
+        let mut span: Option<(Nanos, Nanos)> = None;
         for rec in records(&chunk.data) {
             let (op_in, b, _) = rec.map_err(bad("chunk", pos))?;
             let summary = &mut self.summary;
@@ -350,16 +349,26 @@ impl LinearIndex {
                 op::MESSAGE => {
                     let h = parse_message_header(b).map_err(bad("message in chunk", pos))?;
                     ids.insert(h.channel);
-                    self.count(h.channel, Nanos(h.log_time));
+                    let t = Nanos(h.log_time);
+                    span = Some(span.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
+                    self.count(h.channel, t);
                 }
                 _ => {}
             }
         }
+        // the merge orders chunks by their messages' real times, not the header's claim
+        let (start, end) = span.unwrap_or((chunk.start, chunk.end));
+        if (start, end) != (chunk.start, chunk.end) && span.is_some() {
+            self.summary.warnings.push(format!(
+                "chunk at byte {pos} declares {}..{} s, its messages lie in {start}..{end} s",
+                chunk.start, chunk.end
+            ));
+        }
         self.summary.chunks.push(ChunkInfo {
             offset: pos,
             length: RECORD_HEAD_LEN as u64 + len,
-            start: chunk.start,
-            end: chunk.end,
+            start,
+            end,
             compression: chunk.compression,
             channels: Some(ids),
         });

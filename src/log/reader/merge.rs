@@ -100,6 +100,8 @@ impl Catalog {
                 Keep::Skip
             }
         };
+        // The declared time ranges (index and header) are not trusted: the merge checks the
+        // messages' own times as it goes (`Indexed::next`).
         let opened = open_chunk_keeping(
             body,
             chunk_offset,
@@ -107,17 +109,6 @@ impl Catalog {
             chunk.channels.as_ref(),
             &mut keep,
         )?;
-        let (start, end) = (opened.start, opened.end);
-        if chunk.length > 0 && (start, end) != (chunk.start, chunk.end) {
-            return Err(LogErrorKind::BadRecord {
-                record: "chunk",
-                offset: chunk_offset,
-                reason: format!(
-                    "header time range {start}..{end} s differs from the index's {}..{} s",
-                    chunk.start, chunk.end
-                ),
-            });
-        }
         let data = opened.data;
         let mut entries = Vec::new();
         for rec in records(&data) {
@@ -277,6 +268,8 @@ impl ChunkMerge {
 struct Indexed {
     file: File,
     merge: ChunkMerge,
+    /// Log time of the latest message handed out.
+    yielded: Option<u64>,
 }
 
 /// Records read front to back (messages outside chunks).
@@ -334,6 +327,7 @@ impl MessageStream {
             Mode::Indexed(Indexed {
                 file,
                 merge: ChunkMerge::new(pending),
+                yielded: None,
             })
         };
         MessageStream {
@@ -366,6 +360,18 @@ impl Indexed {
                 "chunk record",
             )?;
             let slot = catalog.load(chunk_body(&rec, &chunk)?, &chunk)?;
+            // The merge loads a chunk by its declared start; a message before it is still
+            // merged in order unless a later one was already handed out.
+            if let (Some(&(first, _)), Some(previous)) = (slot.entries.first(), self.yielded)
+                && first < previous
+            {
+                return Err(LogErrorKind::ChunkStartsEarlier {
+                    offset: chunk.offset,
+                    start: chunk.start,
+                    this: Nanos(first),
+                    previous: Nanos(previous),
+                });
+            }
             self.merge.insert(slot);
             if self.merge.held > MAX_HELD_BYTES {
                 return Err(LogErrorKind::BadRecord {
@@ -379,9 +385,11 @@ impl Indexed {
             }
         }
         match self.merge.pop() {
-            Some((buf, at, chunk_offset)) => catalog
-                .message_at(&buf, at as usize, chunk_offset)
-                .map(Some),
+            Some((buf, at, chunk_offset)) => {
+                let m = catalog.message_at(&buf, at as usize, chunk_offset)?;
+                self.yielded = Some(m.log_time.0);
+                Ok(Some(m))
+            }
             None => Ok(None),
         }
     }
