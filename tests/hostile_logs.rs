@@ -400,3 +400,106 @@ fn inspect_says_when_a_log_carries_no_crcs() {
     assert!(c.incomplete());
     assert!(text.contains("messages outside chunks carry no CRC"), "{text}");
 }
+
+/// A log of 40 `/x` JSON messages (1..=40 s) in small uncompressed chunks with CRCs.
+fn chunked_log(dir: &Path) -> (PathBuf, Vec<peopletrack::log::reader::ChunkInfo>) {
+    let p = dir.join("full.mcap");
+    let options = WriterOptions {
+        compression: peopletrack::log::Compression::None,
+        chunk_size: 200,
+        ..WriterOptions::default()
+    };
+    let mut w = SessionWriter::create(&p, &options).expect("create");
+    let ch = w.add_json("/x", "X", "{}").expect("channel");
+    for i in 1..=40u64 {
+        w.write_json(ch, Nanos(i * 1_000_000_000), &serde_json::json!({ "i": i }))
+            .expect("write");
+    }
+    let p = w.finish().expect("finish");
+    let chunks = SessionLog::open(&p).expect("opens").summary().chunks.clone();
+    assert!(chunks.len() >= 4, "several chunks: {}", chunks.len());
+    (p, chunks)
+}
+
+#[test]
+fn recover_reads_every_complete_chunk_before_a_cut_and_says_what_was_lost() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (full, chunks) = chunked_log(dir.path());
+    let data = std::fs::read(&full).expect("read");
+    let all: Vec<u64> = (1..=40).map(|i| i * 1_000_000_000).collect();
+    let second = &chunks[1];
+    let second_end = (second.offset + second.length) as usize;
+    let third = chunks[2].offset as usize;
+    // cut exactly at the end of the second chunk, inside the message index after it, and in
+    // the middle of the third chunk: (cut, where the damaged record starts)
+    for (cut, damage) in [
+        (second_end, second_end),
+        (second_end + 40, second_end),
+        (third + 20, third),
+    ] {
+        let p = dir.path().join(format!("cut_{cut}.mcap"));
+        std::fs::write(&p, &data[..cut]).expect("write");
+        let out = peopletrack()
+            .args(["cat", "--topic", "/x"])
+            .arg(&p)
+            .output()
+            .expect("runs");
+        assert_eq!(out.status.code(), Some(1), "without --recover: an error");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("truncated"));
+        let out = peopletrack()
+            .args(["cat", "--recover", "--topic", "/x"])
+            .arg(&p)
+            .output()
+            .expect("runs");
+        assert!(out.status.success());
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let times: Vec<u64> = stdout
+            .lines()
+            .map(|l| {
+                let v: serde_json::Value = serde_json::from_str(l).expect("json line");
+                v["log_time_ns"].as_u64().expect("time")
+            })
+            .collect();
+        let last_complete = *times.last().expect("some messages");
+        // the messages of the first two chunks, in order, and nothing invented
+        assert_eq!(times, all[..times.len()]);
+        assert_eq!(Nanos(last_complete), second.end);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let lost = format!("bytes {damage}..{cut} ({} bytes) are lost", cut - damage);
+        assert!(stderr.contains("warning:") && stderr.contains(&lost), "{stderr}");
+        assert!(
+            stderr.contains(&format!("the last complete message is /x at {}", second.end)),
+            "{stderr}"
+        );
+    }
+}
+
+#[test]
+fn recover_skips_a_corrupt_chunk_and_reads_the_good_ones_after_it() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (full, chunks) = chunked_log(dir.path());
+    let mut data = std::fs::read(&full).expect("read");
+    let bad = &chunks[1];
+    let flip = (bad.offset + bad.length - 3) as usize; // inside its records
+    data[flip] ^= 0x55;
+    let p = dir.path().join("flipped.mcap");
+    std::fs::write(&p, &data).expect("write");
+    assert!(read_everything(&p).is_err(), "without --recover: the CRC error");
+    let log = SessionLog::open_recovering(&p).expect("opens");
+    let n = log.messages().expect("stream").count();
+    let good = SessionLog::open(&full).expect("opens");
+    let in_bad = good
+        .messages()
+        .expect("stream")
+        .filter(|m| m.as_ref().is_ok_and(|m| m.log_time >= bad.start && m.log_time <= bad.end))
+        .count();
+    assert_eq!(n, 40 - in_bad);
+    assert_eq!(log.summary().warnings.len(), 1, "{:?}", log.summary().warnings);
+    let w = &log.summary().warnings[0];
+    assert!(
+        w.contains(&format!("the chunk at byte {} ({} bytes", bad.offset, bad.length))
+            && w.contains(&format!("declared {}..{} s", bad.start, bad.end))
+            && w.contains("CRC"),
+        "{w}"
+    );
+}

@@ -63,7 +63,7 @@ pub enum CdrErrorKind {
         need: usize,
         have: usize,
     },
-    #[error("sequence length {len} at byte {offset} cannot fit in the {remaining} bytes left")]
+    #[error("array length {len} at byte {offset} cannot fit in the {remaining} bytes left")]
     LengthTooLarge {
         offset: usize,
         len: u64,

@@ -75,15 +75,16 @@ pub enum LogErrorKind {
         this: Nanos,
         previous: Nanos,
     },
-    #[error("schema `{schema}` does not parse: {source}")]
-    Schema { schema: String, source: SchemaError },
-    #[error("{0}")]
+    // `error`, not `source`: a source would be printed twice in an error chain
+    #[error("schema `{schema}` does not parse: {error}")]
+    Schema { schema: String, error: SchemaError },
+    #[error(transparent)]
     Cdr(#[from] CdrError),
     #[error("{0}")]
     Protobuf(String),
     #[error("JSON message does not parse: {0}")]
     Json(String),
-    #[error("{0}")]
+    #[error(transparent)]
     Field(#[from] FieldError),
     #[error(
         "no decoder for message encoding `{message_encoding}` with schema encoding `{schema_encoding}` (supported: cdr/ros2msg, protobuf/protobuf, json/jsonschema or none)"

@@ -108,6 +108,23 @@ impl SessionLog {
         Ok(SessionLog { path, summary })
     }
 
+    /// Open a damaged log (`--recover`): index it front to back, leaving out chunks that do
+    /// not open and stopping where the file is cut or its records lose their framing. What
+    /// was lost is said in [`LogSummary::warnings`]; the messages read are the complete ones
+    /// before the damage (and in any good chunk after a bad one).
+    pub fn open_recovering(path: impl AsRef<Path>) -> Result<SessionLog, LogError> {
+        let path = path.as_ref().to_path_buf();
+        let err = |k: LogErrorKind| LogError::new(&path, k);
+        let mut file = File::open(&path).map_err(|e| err(e.into()))?;
+        let file_len = file.metadata().map_err(|e| err(e.into()))?.len();
+        let mut magic = [0u8; 8];
+        if file_len < 8 || file.read_exact(&mut magic).is_err() || &magic != records::MAGIC {
+            return Err(err(LogErrorKind::NotMcap));
+        }
+        let summary = index::recovering_index(&mut file, file_len).map_err(err)?;
+        Ok(SessionLog { path, summary })
+    }
+
     pub fn path(&self) -> &Path {
         &self.path
     }

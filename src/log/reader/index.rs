@@ -358,7 +358,7 @@ impl LinearIndex {
         }
         // the merge orders chunks by their messages' real times, not the header's claim
         let (start, end) = span.unwrap_or((chunk.start, chunk.end));
-        if (start, end) != (chunk.start, chunk.end) && span.is_some() {
+        if start < chunk.start || end > chunk.end {
             self.summary.warnings.push(format!(
                 "chunk at byte {pos} declares {}..{} s, its messages lie in {start}..{end} s",
                 chunk.start, chunk.end
@@ -386,14 +386,29 @@ impl LinearIndex {
 
 /// Build the index by reading the file front to back (no usable summary section).
 pub(super) fn linear_index(file: &mut File, file_len: u64) -> Result<LogSummary, LogErrorKind> {
+    linear_pass(file, file_len, false)
+}
+
+/// [`linear_index`] for `--recover`: a chunk that does not open (CRC, decompression, a bad
+/// record inside) is skipped, and a cut or corrupt record framing ends the index there; each
+/// loss is said in [`LogSummary::warnings`] (bytes, time span where known, last good message).
+/// The stream then reads only what was indexed.
+pub(super) fn recovering_index(
+    file: &mut File,
+    file_len: u64,
+) -> Result<LogSummary, LogErrorKind> {
+    linear_pass(file, file_len, true)
+}
+
+fn linear_pass(file: &mut File, file_len: u64, recover: bool) -> Result<LogSummary, LogErrorKind> {
     let mut index = LinearIndex::new(file_len);
     let mut reader = BufReader::with_capacity(1 << 16, &mut *file);
     reader.seek(SeekFrom::Start(8))?;
     let mut pos = 8u64;
     let head_len = RECORD_HEAD_LEN as u64;
     loop {
-        if pos + head_len > file_len {
-            return Err(LogErrorKind::Truncated {
+        let cut = if pos + head_len > file_len {
+            Some(LogErrorKind::Truncated {
                 what: if pos == file_len {
                     "footer record"
                 } else {
@@ -403,19 +418,27 @@ pub(super) fn linear_index(file: &mut File, file_len: u64) -> Result<LogSummary,
                 needed: head_len,
                 file_len,
                 last: index.last_named(),
-            });
-        }
+            })
+        } else {
+            None
+        };
         let mut head = [0u8; RECORD_HEAD_LEN];
-        reader.read_exact(&mut head)?;
-        let (opcode, len) = record_head(&head);
+        let (opcode, len) = match cut {
+            Some(e) => return index.damaged(e, pos, recover),
+            None => {
+                reader.read_exact(&mut head)?;
+                record_head(&head)
+            }
+        };
         if len > file_len - pos - head_len {
-            return Err(LogErrorKind::Truncated {
+            let e = LogErrorKind::Truncated {
                 what: record_name(opcode),
                 offset: pos,
                 needed: len.saturating_add(head_len),
                 file_len,
                 last: index.last_named(),
-            });
+            };
+            return index.damaged(e, pos, recover);
         }
         if opcode == op::FOOTER {
             // a complete file ends with the footer and the closing magic
@@ -424,24 +447,63 @@ pub(super) fn linear_index(file: &mut File, file_len: u64) -> Result<LogSummary,
             reader.seek_relative(len as i64)?;
             (&mut reader).take(8).read_to_end(&mut tail)?;
             if tail.as_slice() != MAGIC {
-                return Err(LogErrorKind::Truncated {
+                let e = LogErrorKind::Truncated {
                     what: "closing magic",
                     offset: end,
                     needed: 8,
                     file_len,
                     last: index.last_named(),
-                });
+                };
+                return index.damaged(e, end, recover);
             }
             break;
         }
         if LinearIndex::needs_body(opcode) {
             let mut body = vec![0u8; len as usize];
             reader.read_exact(&mut body)?;
-            index.record(opcode, &body, pos, len)?;
+            match index.record(opcode, &body, pos, len) {
+                Err(e) if recover && opcode == op::CHUNK => index.skip_chunk(e, &body, pos, len),
+                other => other?,
+            }
         } else {
             reader.seek_relative(len as i64)?;
         }
         pos += head_len + len;
     }
     Ok(index.finish())
+}
+
+impl LinearIndex {
+    /// The file is damaged at byte `at`: an error, or (recovering) the index so far with
+    /// the loss said and the file treated as ending there.
+    fn damaged(
+        mut self,
+        e: LogErrorKind,
+        at: u64,
+        recover: bool,
+    ) -> Result<LogSummary, LogErrorKind> {
+        if !recover {
+            return Err(e);
+        }
+        // the error names the last complete message
+        let file_len = self.summary.file_len;
+        self.summary.warnings.push(format!(
+            "recovered: {e}; bytes {at}..{file_len} ({} bytes) are lost",
+            file_len - at
+        ));
+        self.summary.file_len = at;
+        Ok(self.finish())
+    }
+
+    /// Recovering: a chunk that does not open is left out, and its loss said.
+    fn skip_chunk(&mut self, e: LogErrorKind, body: &[u8], pos: u64, len: u64) {
+        let span = match super::records::parse_chunk(body) {
+            Ok(h) => format!(", declared {}..{} s", Nanos(h.start), Nanos(h.end)),
+            Err(_) => String::new(),
+        };
+        self.summary.warnings.push(format!(
+            "recovered: the chunk at byte {pos} ({} bytes{span}) is skipped: {e}",
+            len + RECORD_HEAD_LEN as u64
+        ));
+    }
 }
