@@ -61,11 +61,7 @@ fn nested_schema(depth: usize) -> String {
 /// abort) and say every `needle` on stderr.
 fn cli_fails_clearly(log: &Path, needles: &[&str]) {
     for args in [vec!["cat", "--topic", "/x"], vec!["inspect"]] {
-        let out = peopletrack()
-            .args(&args)
-            .arg(log)
-            .output()
-            .expect("runs");
+        let out = peopletrack().args(&args).arg(log).output().expect("runs");
         let stderr = String::from_utf8_lossy(&out.stderr);
         let stdout = String::from_utf8_lossy(&out.stdout);
         if args[0] == "inspect" {
@@ -86,7 +82,12 @@ fn cli_fails_clearly(log: &Path, needles: &[&str]) {
 #[test]
 fn schema_nested_ten_thousand_deep_is_an_error_in_cat_and_inspect_not_a_stack_overflow() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let p = one_message_log(dir.path(), "deep.mcap", &nested_schema(10_000), &raw::cdr(&[7]));
+    let p = one_message_log(
+        dir.path(),
+        "deep.mcap",
+        &nested_schema(10_000),
+        &raw::cdr(&[7]),
+    );
     let msg = read_everything(&p).expect_err("too deep").to_string();
     for needle in ["deep.mcap", "/x", "p/msg/T0", "nest more than 64"] {
         assert!(msg.contains(needle), "`{needle}` missing from: {msg}");
@@ -97,7 +98,12 @@ fn schema_nested_ten_thousand_deep_is_an_error_in_cat_and_inspect_not_a_stack_ov
 #[test]
 fn schema_nested_two_thousand_deep_fails_inside_a_worker_thread_without_aborting() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let p = one_message_log(dir.path(), "deep.mcap", &nested_schema(2_000), &raw::cdr(&[7]));
+    let p = one_message_log(
+        dir.path(),
+        "deep.mcap",
+        &nested_schema(2_000),
+        &raw::cdr(&[7]),
+    );
     // a pipeline worker: a spawned thread with the default stack
     let result = std::thread::spawn(move || read_everything(&p).map_err(|e| e.to_string()))
         .join()
@@ -112,7 +118,12 @@ fn nesting_at_the_limit_decodes_prints_and_drops_in_a_worker_thread() {
     let over = one_message_log(dir.path(), "over.mcap", &nested_schema(65), &raw::cdr(&[7]));
     let printed = std::thread::spawn(move || {
         let log = SessionLog::open(&ok).expect("opens");
-        let m = log.messages().expect("stream").next().expect("one").expect("reads");
+        let m = log
+            .messages()
+            .expect("stream")
+            .next()
+            .expect("one")
+            .expect("reads");
         let v = Decoders::new().value(&log, &m).expect("64 levels decode");
         v.to_json(None).to_string()
     })
@@ -120,10 +131,17 @@ fn nesting_at_the_limit_decodes_prints_and_drops_in_a_worker_thread() {
     .expect("no stack overflow at the limit");
     assert_eq!(
         printed,
-        format!("{}{{\"leaf\":7}}{}", "{\"inner\":".repeat(63), "}".repeat(63))
+        format!(
+            "{}{{\"leaf\":7}}{}",
+            "{\"inner\":".repeat(63),
+            "}".repeat(63)
+        )
     );
     let msg = read_everything(&over).expect_err("65 levels").to_string();
-    assert!(msg.contains("p/msg/T0") && msg.contains("nest more than 64"), "{msg}");
+    assert!(
+        msg.contains("p/msg/T0") && msg.contains("nest more than 64"),
+        "{msg}"
+    );
 }
 
 #[test]
@@ -254,7 +272,11 @@ fn recursive_protobuf_type_reads_unset_children_as_empty_instead_of_recursing_fo
         let mut outer = vec![0x0a, deep.len() as u8];
         if deep.len() >= 0x80 {
             // two-byte varint length
-            outer = vec![0x0a, (deep.len() as u8 & 0x7f) | 0x80, (deep.len() >> 7) as u8];
+            outer = vec![
+                0x0a,
+                (deep.len() as u8 & 0x7f) | 0x80,
+                (deep.len() >> 7) as u8,
+            ];
         }
         outer.extend(deep);
         deep = outer;
@@ -297,7 +319,9 @@ fn message_before_its_chunks_declared_start_is_never_delivered_out_of_order() {
     let p = dir.path().join("lying_index.mcap");
     std::fs::write(&p, &indexed).expect("write");
     // it used to print 0, 30, 20, 100 with exit 0
-    let msg = read_everything(&p).expect_err("order cannot be kept").to_string();
+    let msg = read_everything(&p)
+        .expect_err("order cannot be kept")
+        .to_string();
     for needle in [
         "lying_index.mcap",
         &format!("chunk at byte {b_at}"),
@@ -332,7 +356,10 @@ fn statistics_of_zero_messages_without_a_chunk_index_fall_back_to_a_linear_scan(
     let p = dir.path().join("zero_stats.mcap");
     std::fs::write(
         &p,
-        raw::file(&[&channel, &chunk], &[&channel, &raw::statistics(0, 0, 0, 0)]),
+        raw::file(
+            &[&channel, &chunk],
+            &[&channel, &raw::statistics(0, 0, 0, 0)],
+        ),
     )
     .expect("write");
     // it used to say `messages: 0` and print nothing
@@ -343,13 +370,18 @@ fn statistics_of_zero_messages_without_a_chunk_index_fall_back_to_a_linear_scan(
     let log = SessionLog::open(&p).expect("opens");
     assert_eq!(
         log.summary().warnings,
-        ["the summary section says 0 messages and has no chunk index; a linear scan of the \
-          data found 5, and the index was rebuilt from the data"]
+        [
+            "the summary section says 0 messages and has no chunk index; a linear scan of the \
+          data found 5, and the index was rebuilt from the data"
+        ]
     );
     let out = peopletrack().arg("inspect").arg(&p).output().expect("runs");
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("messages:  5\n"), "{text}");
-    assert!(text.contains("warning:   the summary section says 0 messages"), "{text}");
+    assert!(
+        text.contains("warning:   the summary section says 0 messages"),
+        "{text}"
+    );
     let out = peopletrack()
         .args(["cat", "--topic", "/x"])
         .arg(&p)
@@ -359,10 +391,19 @@ fn statistics_of_zero_messages_without_a_chunk_index_fall_back_to_a_linear_scan(
     assert!(String::from_utf8_lossy(&out.stderr).contains("linear scan"));
     // a log that really is empty stays empty, without a warning
     let p = dir.path().join("empty.mcap");
-    std::fs::write(&p, raw::file(&[&channel], &[&channel, &raw::statistics(0, 0, 0, 0)]))
-        .expect("write");
+    std::fs::write(
+        &p,
+        raw::file(&[&channel], &[&channel, &raw::statistics(0, 0, 0, 0)]),
+    )
+    .expect("write");
     assert!(read_everything(&p).expect("reads").is_empty());
-    assert!(SessionLog::open(&p).expect("opens").summary().warnings.is_empty());
+    assert!(
+        SessionLog::open(&p)
+            .expect("opens")
+            .summary()
+            .warnings
+            .is_empty()
+    );
 }
 
 #[test]
@@ -374,7 +415,10 @@ fn inspect_says_when_a_log_carries_no_crcs() {
         let mut data: Vec<&[u8]> = vec![&channel];
         data.extend_from_slice(chunks);
         std::fs::write(&p, raw::file(&data, &[])).expect("write");
-        let crc = SessionLog::open(&p).expect("opens").crc_coverage().expect("crc");
+        let crc = SessionLog::open(&p)
+            .expect("opens")
+            .crc_coverage()
+            .expect("crc");
         let out = peopletrack().arg("inspect").arg(&p).output().expect("runs");
         (crc, String::from_utf8_lossy(&out.stdout).into_owned())
     };
@@ -395,10 +439,16 @@ fn inspect_says_when_a_log_carries_no_crcs() {
     assert!(text.contains("1 of 2 chunks carry no CRC"), "{text}");
     let (c, text) = inspect("checked.mcap", &[&crc]);
     assert!(!c.incomplete());
-    assert!(text.contains("crc:       all 1 chunks carry a CRC"), "{text}");
+    assert!(
+        text.contains("crc:       all 1 chunks carry a CRC"),
+        "{text}"
+    );
     let (c, text) = inspect("loose.mcap", &[&json_messages(&[5])]);
     assert!(c.incomplete());
-    assert!(text.contains("messages outside chunks carry no CRC"), "{text}");
+    assert!(
+        text.contains("messages outside chunks carry no CRC"),
+        "{text}"
+    );
 }
 
 /// A log of 40 `/x` JSON messages (1..=40 s) in small uncompressed chunks with CRCs.
@@ -416,7 +466,11 @@ fn chunked_log(dir: &Path) -> (PathBuf, Vec<peopletrack::log::reader::ChunkInfo>
             .expect("write");
     }
     let p = w.finish().expect("finish");
-    let chunks = SessionLog::open(&p).expect("opens").summary().chunks.clone();
+    let chunks = SessionLog::open(&p)
+        .expect("opens")
+        .summary()
+        .chunks
+        .clone();
     assert!(chunks.len() >= 4, "several chunks: {}", chunks.len());
     (p, chunks)
 }
@@ -466,9 +520,15 @@ fn recover_reads_every_complete_chunk_before_a_cut_and_says_what_was_lost() {
         assert_eq!(Nanos(last_complete), second.end);
         let stderr = String::from_utf8_lossy(&out.stderr);
         let lost = format!("bytes {damage}..{cut} ({} bytes) are lost", cut - damage);
-        assert!(stderr.contains("warning:") && stderr.contains(&lost), "{stderr}");
         assert!(
-            stderr.contains(&format!("the last complete message is /x at {}", second.end)),
+            stderr.contains("warning:") && stderr.contains(&lost),
+            "{stderr}"
+        );
+        assert!(
+            stderr.contains(&format!(
+                "the last complete message is /x at {}",
+                second.end
+            )),
             "{stderr}"
         );
     }
@@ -484,21 +544,34 @@ fn recover_skips_a_corrupt_chunk_and_reads_the_good_ones_after_it() {
     data[flip] ^= 0x55;
     let p = dir.path().join("flipped.mcap");
     std::fs::write(&p, &data).expect("write");
-    assert!(read_everything(&p).is_err(), "without --recover: the CRC error");
+    assert!(
+        read_everything(&p).is_err(),
+        "without --recover: the CRC error"
+    );
     let log = SessionLog::open_recovering(&p).expect("opens");
     let n = log.messages().expect("stream").count();
     let good = SessionLog::open(&full).expect("opens");
     let in_bad = good
         .messages()
         .expect("stream")
-        .filter(|m| m.as_ref().is_ok_and(|m| m.log_time >= bad.start && m.log_time <= bad.end))
+        .filter(|m| {
+            m.as_ref()
+                .is_ok_and(|m| m.log_time >= bad.start && m.log_time <= bad.end)
+        })
         .count();
     assert_eq!(n, 40 - in_bad);
-    assert_eq!(log.summary().warnings.len(), 1, "{:?}", log.summary().warnings);
+    assert_eq!(
+        log.summary().warnings.len(),
+        1,
+        "{:?}",
+        log.summary().warnings
+    );
     let w = &log.summary().warnings[0];
     assert!(
-        w.contains(&format!("the chunk at byte {} ({} bytes", bad.offset, bad.length))
-            && w.contains(&format!("declared {}..{} s", bad.start, bad.end))
+        w.contains(&format!(
+            "the chunk at byte {} ({} bytes",
+            bad.offset, bad.length
+        )) && w.contains(&format!("declared {}..{} s", bad.start, bad.end))
             && w.contains("CRC"),
         "{w}"
     );

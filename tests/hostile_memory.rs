@@ -103,18 +103,33 @@ fn hostile_logs_stay_within_64_mib_beyond_the_largest_message() {
     let (peak, result) = peak_reading(&p);
     assert_eq!(result, Ok(3));
     assert!(peak < 64 * MIB, "bomb: peak heap {} MiB", peak / MIB);
-    eprintln!("bomb.mcap ({} bytes): peak heap {:.1} MiB", bytes.len(), peak as f64 / MIB as f64);
+    eprintln!(
+        "bomb.mcap ({} bytes): peak heap {:.1} MiB",
+        bytes.len(),
+        peak as f64 / MIB as f64
+    );
 
     // a fixed array of 10^12 empty messages (each a dummy byte, or nothing at all): it used
     // to allocate 3.25 GB and abort
     for (name, text) in [
-        ("empty_structs.mcap", "p/E[1000000000000] e\n===\nMSG: p/E\n"),
-        ("zero_structs.mcap", "p/Z[1000000000000] z\n===\nMSG: p/Z\nuint8[0] nothing\n"),
+        (
+            "empty_structs.mcap",
+            "p/E[1000000000000] e\n===\nMSG: p/E\n",
+        ),
+        (
+            "zero_structs.mcap",
+            "p/Z[1000000000000] z\n===\nMSG: p/Z\nuint8[0] nothing\n",
+        ),
     ] {
         let schema = raw::schema(1, "p/msg/T0", "ros2msg", text.as_bytes());
         let channel = raw::channel(1, 1, "/x", "cdr");
         let message = raw::message(1, 1, 5, &raw::cdr(&[1, 2, 3, 4]));
-        let chunk = raw::chunk(5, 5, &[schema.clone(), channel.clone(), message].concat(), true);
+        let chunk = raw::chunk(
+            5,
+            5,
+            &[schema.clone(), channel.clone(), message].concat(),
+            true,
+        );
         let bytes = raw::file(&[&schema, &channel, &chunk], &[]);
         let p = keep(dir.path(), name, &bytes);
         let (peak, result) = peak_reading(&p);
@@ -124,7 +139,12 @@ fn hostile_logs_stay_within_64_mib_beyond_the_largest_message() {
     }
 
     // an 8 MiB message of one-byte structs: it used to peak at 806 MB
-    let schema = raw::schema(1, "p/msg/T0", "ros2msg", b"p/B[] items\n===\nMSG: p/B\nuint8 v\n");
+    let schema = raw::schema(
+        1,
+        "p/msg/T0",
+        "ros2msg",
+        b"p/B[] items\n===\nMSG: p/B\nuint8 v\n",
+    );
     let channel = raw::channel(1, 1, "/x", "cdr");
     let mut body = (8u32 << 20).to_le_bytes().to_vec();
     body.resize(4 + 8 * MIB, 1);
@@ -133,7 +153,18 @@ fn hostile_logs_stay_within_64_mib_beyond_the_largest_message() {
     let bytes = raw::file(&[&schema, &channel, &chunk], &[]);
     let p = keep(dir.path(), "one_byte_structs.mcap", &bytes);
     let (peak, result) = peak_reading(&p);
-    assert!(result.expect_err("too large a tree").contains("bytes of structure"));
-    assert!(peak < 8 * MIB + 64 * MIB, "one-byte structs: peak heap {} MiB", peak / MIB);
-    eprintln!("one_byte_structs.mcap: peak heap {:.1} MiB", peak as f64 / MIB as f64);
+    assert!(
+        result
+            .expect_err("too large a tree")
+            .contains("bytes of structure")
+    );
+    assert!(
+        peak < 8 * MIB + 64 * MIB,
+        "one-byte structs: peak heap {} MiB",
+        peak / MIB
+    );
+    eprintln!(
+        "one_byte_structs.mcap: peak heap {:.1} MiB",
+        peak as f64 / MIB as f64
+    );
 }

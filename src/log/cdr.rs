@@ -23,9 +23,7 @@
 
 use std::sync::Arc;
 
-use super::ros2msg::{
-    ArrayKind, BaseType, MAX_NESTING, Prim, Registry, min_wire_size,
-};
+use super::ros2msg::{ArrayKind, BaseType, MAX_NESTING, Prim, Registry, min_wire_size};
 use super::value::Value;
 
 /// Most elements accepted in one array of a type that takes no bytes on the wire (a struct of

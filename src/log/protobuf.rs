@@ -10,11 +10,11 @@ use prost_reflect::{
     DescriptorPool, DynamicMessage, MessageDescriptor, ReflectMessage, Value as Pv,
 };
 
+use super::cdr::tree_budget;
 use super::msgs::{
     self, CameraInfo, CompressedImage, Header, Image, LaserScan, PoseStamped, RegionOfInterest,
     TfMessage, Time, Transform, TransformStamped, field,
 };
-use super::cdr::tree_budget;
 use super::ros2msg::MAX_NESTING;
 use super::value::{FieldError, Value};
 use nalgebra::{Quaternion, Vector3};
@@ -67,7 +67,9 @@ impl Tree {
 
     fn message(&mut self, msg: &DynamicMessage) -> Result<Value, String> {
         if self.open.len() >= MAX_NESTING {
-            return Err(format!("protobuf message nests more than {MAX_NESTING} deep"));
+            return Err(format!(
+                "protobuf message nests more than {MAX_NESTING} deep"
+            ));
         }
         let desc = msg.descriptor();
         self.open.push(desc.full_name().to_string());

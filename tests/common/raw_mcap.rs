@@ -71,7 +71,11 @@ pub fn chunk_raw(
 
 /// An uncompressed chunk of `records` with their CRC (or 0) and the declared time range.
 pub fn chunk(start: u64, end: u64, records: &[u8], with_crc: bool) -> Vec<u8> {
-    let crc = if with_crc { crc32fast::hash(records) } else { 0 };
+    let crc = if with_crc {
+        crc32fast::hash(records)
+    } else {
+        0
+    };
     chunk_raw(start, end, records.len() as u64, crc, "", records)
 }
 
@@ -129,7 +133,11 @@ pub fn file(data: &[&[u8]], summary: &[&[u8]]) -> Vec<u8> {
         f.extend_from_slice(r);
     }
     f.extend(data_end());
-    let summary_start = if summary.is_empty() { 0 } else { f.len() as u64 };
+    let summary_start = if summary.is_empty() {
+        0
+    } else {
+        f.len() as u64
+    };
     for r in summary {
         f.extend_from_slice(r);
     }

@@ -89,9 +89,7 @@ pub(super) fn open_chunk_keeping(
         return Err(LogErrorKind::BadRecord {
             record: "chunk",
             offset,
-            reason: format!(
-                "uncompressed size {want} exceeds the {MAX_CHUNK_BYTES} byte limit"
-            ),
+            reason: format!("uncompressed size {want} exceeds the {MAX_CHUNK_BYTES} byte limit"),
         });
     }
     let fail = |reason: String| LogErrorKind::Decompress {
@@ -134,7 +132,9 @@ pub(super) fn open_chunk_keeping(
     // the declared size must be the whole stream
     let mut extra = [0u8; 1];
     if r.read(&mut extra).map_err(|e| fail(e.to_string()))? > 0 {
-        return Err(fail(format!("gave more bytes than the {want} the header says")));
+        return Err(fail(format!(
+            "gave more bytes than the {want} the header says"
+        )));
     }
     if h.crc != 0 {
         let computed = r.crc.finalize();

@@ -18,8 +18,8 @@ use super::chunk::{Keep, open_chunk_keeping};
 use super::io::read_at;
 use super::records::{
     ChannelInfo, ChunkInfo, Cursor, MAGIC, MetadataRecord, RECORD_HEAD_LEN, SchemaInfo, Statistics,
-    add_channel, bad, op, parse_channel, parse_chunk_index, parse_message_header,
-    parse_metadata, parse_schema, parse_statistics, record_head, record_name, records,
+    add_channel, bad, op, parse_channel, parse_chunk_index, parse_message_header, parse_metadata,
+    parse_schema, parse_statistics, record_head, record_name, records,
 };
 use crate::time::Nanos;
 
@@ -330,8 +330,9 @@ impl LinearIndex {
     /// Index a chunk: decompress it once, register its schemas and channels, count messages.
     fn chunk(&mut self, body: &[u8], pos: u64, len: u64) -> Result<(), LogErrorKind> {
         // only the messages' headers are kept: the pass needs channels and times
-        let chunk =
-            open_chunk_keeping(body, pos, &self.summary.channels, None, &mut |_| Keep::Header)?;
+        let chunk = open_chunk_keeping(body, pos, &self.summary.channels, None, &mut |_| {
+            Keep::Header
+        })?;
         let mut ids = BTreeSet::new();
         let mut span: Option<(Nanos, Nanos)> = None;
         for rec in records(&chunk.data) {
@@ -393,10 +394,7 @@ pub(super) fn linear_index(file: &mut File, file_len: u64) -> Result<LogSummary,
 /// record inside) is skipped, and a cut or corrupt record framing ends the index there; each
 /// loss is said in [`LogSummary::warnings`] (bytes, time span where known, last good message).
 /// The stream then reads only what was indexed.
-pub(super) fn recovering_index(
-    file: &mut File,
-    file_len: u64,
-) -> Result<LogSummary, LogErrorKind> {
+pub(super) fn recovering_index(file: &mut File, file_len: u64) -> Result<LogSummary, LogErrorKind> {
     linear_pass(file, file_len, true)
 }
 

@@ -18,9 +18,9 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use super::super::error::{LogError, LogErrorKind};
+use super::chunk::{Keep, open_chunk_keeping};
 use super::index::LogSummary;
 use super::io::read_at;
-use super::chunk::{Keep, open_chunk_keeping};
 use super::records::{
     ChannelInfo, ChunkInfo, MESSAGE_HEADER_LEN, RECORD_HEAD_LEN, SchemaInfo, add_channel, bad, op,
     parse_channel, parse_message_header, parse_schema, record_head, record_name, records,

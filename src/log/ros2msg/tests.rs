@@ -53,7 +53,8 @@ fn parses_arrays_bounds_defaults_and_constants() {
 
 #[test]
 fn bare_names_resolve_within_the_package_and_header_to_std_msgs() {
-    let text = "Header header\nInner i\n===\nMSG: p/Inner\nint8 a\n===\nMSG: std_msgs/Header\nuint32 seq";
+    let text =
+        "Header header\nInner i\n===\nMSG: p/Inner\nint8 a\n===\nMSG: std_msgs/Header\nuint32 seq";
     let reg = Registry::parse("p/msg/Outer", text).expect("parses");
     assert_eq!(reg.defs.len(), 3);
 }
