@@ -23,10 +23,21 @@ pub struct Args {
     /// Shorten arrays longer than N elements (the rest is counted, not printed).
     #[arg(long, value_name = "N")]
     pub max_array: Option<usize>,
+    /// Read a damaged (cut or corrupt) log: print every complete message before the damage
+    /// and skip chunks that do not open, saying on stderr what was lost.
+    #[arg(long)]
+    pub recover: bool,
 }
 
 pub fn run(args: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
-    let log = SessionLog::open(&args.log)?;
+    let log = if args.recover {
+        SessionLog::open_recovering(&args.log)?
+    } else {
+        SessionLog::open(&args.log)?
+    };
+    for w in &log.summary().warnings {
+        eprintln!("warning: {}: {w}", args.log.display());
+    }
     let mut decoders = Decoders::new();
     let limit = args.limit.unwrap_or(usize::MAX);
     for m in log.messages_on(&[args.topic.as_str()])?.take(limit) {

@@ -53,6 +53,10 @@ pub struct Report {
     /// Times a frame changed parent.
     pub tf_reparented: u64,
     pub metadata: BTreeMap<String, BTreeMap<String, String>>,
+    /// Whether corruption can be detected ([`peopletrack::log::CrcCoverage::describe`]).
+    pub crc: String,
+    /// Where the file's index disagreed with its data (the data was believed).
+    pub warnings: Vec<String>,
 }
 
 /// Read the whole log once and gather the report.
@@ -68,6 +72,7 @@ pub fn analyze(log: &SessionLog) -> Result<Report, LogError> {
     let start = topics.iter().filter_map(|t| t.first).min();
     let end = topics.iter().filter_map(|t| t.last).max();
     let tf = TfBuffer::from_log(log, 0.0)?;
+    let crc = log.crc_coverage()?;
     let mut compression: Vec<String> = s
         .chunks
         .iter()
@@ -110,6 +115,8 @@ pub fn analyze(log: &SessionLog) -> Result<Report, LogError> {
             .iter()
             .map(|m| (m.name.clone(), m.entries.clone()))
             .collect(),
+        crc: crc.describe(),
+        warnings: s.warnings.clone(),
     })
 }
 
@@ -139,6 +146,10 @@ pub fn render_text(r: &Report) -> String {
         }
     );
     let _ = writeln!(o, "messages:  {}", r.messages);
+    let _ = writeln!(o, "crc:       {}", r.crc);
+    for w in &r.warnings {
+        let _ = writeln!(o, "warning:   {w}");
+    }
     let _ = writeln!(
         o,
         "time:      {} .. {} s ({:.3} s)",

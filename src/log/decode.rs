@@ -40,12 +40,11 @@ impl Decoder {
             ("cdr", "ros2msg") => {
                 let schema = ch.schema.as_deref().expect("ros2msg implies a schema");
                 let text = String::from_utf8_lossy(&schema.data);
-                let reg = Registry::parse(&schema.name, &text).map_err(|source| {
-                    LogErrorKind::Schema {
+                let reg =
+                    Registry::parse(&schema.name, &text).map_err(|error| LogErrorKind::Schema {
                         schema: schema.name.clone(),
-                        source,
-                    }
-                })?;
+                        error,
+                    })?;
                 Ok(Decoder::Cdr(Arc::new(reg)))
             }
             ("protobuf", "protobuf") => {

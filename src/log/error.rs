@@ -66,15 +66,25 @@ pub enum LogErrorKind {
         "messages are not in log-time order ({previous} s, then {this} s) and the file has no chunk index to sort them by; rewrite it with `mcap sort` or `mcap recover`"
     )]
     NotTimeOrdered { previous: Nanos, this: Nanos },
-    #[error("schema `{schema}` does not parse: {source}")]
-    Schema { schema: String, source: SchemaError },
-    #[error("{0}")]
+    #[error(
+        "chunk at byte {offset} declares its messages start at {start} s but holds one at {this} s, before messages already read at {previous} s: the chunk index lies, so log-time order cannot be kept; rewrite the file with `mcap sort`"
+    )]
+    ChunkStartsEarlier {
+        offset: u64,
+        start: Nanos,
+        this: Nanos,
+        previous: Nanos,
+    },
+    // `error`, not `source`: a source would be printed twice in an error chain
+    #[error("schema `{schema}` does not parse: {error}")]
+    Schema { schema: String, error: SchemaError },
+    #[error(transparent)]
     Cdr(#[from] CdrError),
     #[error("{0}")]
     Protobuf(String),
     #[error("JSON message does not parse: {0}")]
     Json(String),
-    #[error("{0}")]
+    #[error(transparent)]
     Field(#[from] FieldError),
     #[error(
         "no decoder for message encoding `{message_encoding}` with schema encoding `{schema_encoding}` (supported: cdr/ros2msg, protobuf/protobuf, json/jsonschema or none)"

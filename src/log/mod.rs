@@ -28,7 +28,7 @@ pub mod writer;
 
 pub use decode::{Decoder, Decoders, read_topic};
 pub use error::{LogError, LogErrorKind};
-pub use reader::{ChannelInfo, LogSummary, Message, MessageStream, SessionLog};
+pub use reader::{ChannelInfo, CrcCoverage, LogSummary, Message, MessageStream, SessionLog};
 pub use tf::TfBuffer;
 pub use value::Value;
 pub use writer::{ChannelId, Compression, SessionWriter, WriterOptions};

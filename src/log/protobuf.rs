@@ -10,10 +10,12 @@ use prost_reflect::{
     DescriptorPool, DynamicMessage, MessageDescriptor, ReflectMessage, Value as Pv,
 };
 
+use super::cdr::tree_budget;
 use super::msgs::{
     self, CameraInfo, CompressedImage, Header, Image, LaserScan, PoseStamped, RegionOfInterest,
     TfMessage, Time, Transform, TransformStamped, field,
 };
+use super::ros2msg::MAX_NESTING;
 use super::value::{FieldError, Value};
 use nalgebra::{Quaternion, Vector3};
 use std::sync::Arc;
@@ -27,64 +29,124 @@ pub fn descriptor(schema_name: &str, descriptor_set: &[u8]) -> Result<MessageDes
 }
 
 /// Decode one protobuf message into a value tree.
+///
+/// Bounded for hostile schemas and payloads: `prost` refuses payloads nested over 100 deep,
+/// the tree is refused past [`MAX_NESTING`] levels, an unset message field of a type already
+/// being expanded (a recursive type) reads as an empty message instead of expanding its
+/// defaults forever, and the tree's size is held to [`tree_budget`].
 pub fn decode(desc: &MessageDescriptor, data: &[u8]) -> Result<Value, String> {
     let msg = DynamicMessage::decode(desc.clone(), data)
         .map_err(|e| format!("protobuf decode failed: {e}"))?;
-    Ok(message_value(&msg))
+    let mut tree = Tree {
+        nodes_left: tree_budget(data.len()) / std::mem::size_of::<(Arc<str>, Value)>(),
+        open: Vec::new(),
+        budget: tree_budget(data.len()),
+    };
+    tree.message(&msg)
 }
 
-fn message_value(msg: &DynamicMessage) -> Value {
-    let desc = msg.descriptor();
-    Value::Struct(
-        desc.fields()
-            .map(|fd| {
-                let v = msg.get_field(&fd);
-                (Arc::from(fd.name()), pv_value(&v))
-            })
-            .collect(),
-    )
+/// The conversion of one decoded message into a [`Value`] tree, with its bounds.
+struct Tree {
+    /// Values that may still be made.
+    nodes_left: usize,
+    /// Full names of the message types being converted, outermost first.
+    open: Vec<String>,
+    budget: usize,
 }
 
-fn pv_value(v: &Pv) -> Value {
-    match v {
-        Pv::Bool(b) => Value::Bool(*b),
-        Pv::I32(x) | Pv::EnumNumber(x) => Value::I32(*x),
-        Pv::I64(x) => Value::I64(*x),
-        Pv::U32(x) => Value::U32(*x),
-        Pv::U64(x) => Value::U64(*x),
-        Pv::F32(x) => Value::F32(*x),
-        Pv::F64(x) => Value::F64(*x),
-        Pv::String(s) => Value::String(s.clone()),
-        Pv::Bytes(b) => Value::Bytes(b.to_vec()),
-        Pv::Message(m) => message_value(m),
-        Pv::List(items) => pack_list(items),
-        Pv::Map(map) => {
-            let mut entries: Vec<(String, Value)> = map
-                .iter()
-                .map(|(k, v)| (format!("{k:?}"), pv_value(v)))
-                .collect();
-            entries.sort_by(|a, b| a.0.cmp(&b.0));
-            Value::Struct(
-                entries
-                    .into_iter()
-                    .map(|(k, v)| (Arc::from(k.as_str()), v))
-                    .collect(),
+impl Tree {
+    fn charge(&mut self, nodes: usize) -> Result<(), String> {
+        self.nodes_left = self.nodes_left.checked_sub(nodes).ok_or_else(|| {
+            format!(
+                "protobuf message would take more than {} bytes as a value tree",
+                self.budget
             )
+        })?;
+        Ok(())
+    }
+
+    fn message(&mut self, msg: &DynamicMessage) -> Result<Value, String> {
+        if self.open.len() >= MAX_NESTING {
+            return Err(format!(
+                "protobuf message nests more than {MAX_NESTING} deep"
+            ));
         }
+        let desc = msg.descriptor();
+        self.open.push(desc.full_name().to_string());
+        let mut fields = Vec::with_capacity(desc.fields().len());
+        for fd in desc.fields() {
+            self.charge(1)?;
+            let recursive_default = !msg.has_field(&fd)
+                && !fd.is_list()
+                && !fd.is_map()
+                && fd
+                    .kind()
+                    .as_message()
+                    .is_some_and(|m| self.open.iter().any(|n| n == m.full_name()));
+            let v = if recursive_default {
+                Value::Struct(Vec::new())
+            } else {
+                self.value(&msg.get_field(&fd))?
+            };
+            fields.push((Arc::from(fd.name()), v));
+        }
+        self.open.pop();
+        Ok(Value::Struct(fields))
+    }
+
+    fn value(&mut self, v: &Pv) -> Result<Value, String> {
+        Ok(match v {
+            Pv::Bool(b) => Value::Bool(*b),
+            Pv::I32(x) | Pv::EnumNumber(x) => Value::I32(*x),
+            Pv::I64(x) => Value::I64(*x),
+            Pv::U32(x) => Value::U32(*x),
+            Pv::U64(x) => Value::U64(*x),
+            Pv::F32(x) => Value::F32(*x),
+            Pv::F64(x) => Value::F64(*x),
+            Pv::String(s) => Value::String(s.clone()),
+            Pv::Bytes(b) => Value::Bytes(b.to_vec()),
+            Pv::Message(m) => self.message(m)?,
+            Pv::List(items) => match pack_list(items) {
+                Some(packed) => packed,
+                None => {
+                    self.charge(items.len())?;
+                    Value::Array(
+                        items
+                            .iter()
+                            .map(|x| self.value(x))
+                            .collect::<Result<_, _>>()?,
+                    )
+                }
+            },
+            Pv::Map(map) => {
+                self.charge(map.len())?;
+                let mut entries = Vec::with_capacity(map.len());
+                for (k, v) in map {
+                    entries.push((format!("{k:?}"), self.value(v)?));
+                }
+                entries.sort_by(|a, b| a.0.cmp(&b.0));
+                Value::Struct(
+                    entries
+                        .into_iter()
+                        .map(|(k, v)| (Arc::from(k.as_str()), v))
+                        .collect(),
+                )
+            }
+        })
     }
 }
 
-/// Repeated scalars become packed arrays, like CDR sequences.
-fn pack_list(items: &[Pv]) -> Value {
+/// Repeated scalars become packed arrays, like CDR sequences (`None`: not all one scalar).
+fn pack_list(items: &[Pv]) -> Option<Value> {
     macro_rules! all {
         ($pat:ident, $variant:ident) => {
             if items.iter().all(|x| matches!(x, Pv::$pat(_))) {
-                return Value::$variant(
+                return Some(Value::$variant(
                     items
                         .iter()
                         .filter_map(|x| if let Pv::$pat(v) = x { Some(*v) } else { None })
                         .collect(),
-                );
+                ));
             }
         };
     }
@@ -97,7 +159,7 @@ fn pack_list(items: &[Pv]) -> Value {
         all!(U64, U64s);
         all!(Bool, Bools);
     }
-    Value::Array(items.iter().map(pv_value).collect())
+    None
 }
 
 type FResult<T> = std::result::Result<T, FieldError>;

@@ -3,13 +3,15 @@
 //! thin shell that opens the file and feeds them.
 //!
 //! - `records`: pure record parsing over `&[u8]` — opcodes, explicit bounds checks (not
-//!   `binrw`), so a corrupt length gives an error but never a huge allocation or a panic;
-//!   chunk decompression and CRCs (rosbags writes 0 = not computed).
+//!   `binrw`), so a corrupt length gives an error but never a huge allocation or a panic.
+//! - `chunk`: chunk decompression as a stream that keeps only the wanted records, and CRCs
+//!   (rosbags writes 0 = not computed).
 //! - `index`: what opening learns — the summary section, or one linear pass without one.
 //! - `merge`: the time-ordered k-way merge of chunks behind [`MessageStream`]; chunks are
 //!   decompressed lazily and freed when consumed, equal log times keep file order.
 //! - `io`: bounded reads at an offset.
 
+mod chunk;
 mod index;
 mod io;
 mod merge;
@@ -25,6 +27,46 @@ use super::error::{LogError, LogErrorKind};
 pub use index::LogSummary;
 pub use merge::{Message, MessageStream, Payload};
 pub use records::{ChannelInfo, ChunkInfo, MetadataRecord, SchemaInfo, Statistics};
+
+/// How many of a log's chunks carry a CRC.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CrcCoverage {
+    pub chunks: usize,
+    pub with_crc: usize,
+    /// Messages outside chunks carry no CRC at all.
+    pub unchunked_messages: bool,
+}
+
+impl CrcCoverage {
+    /// One line for `inspect`: whether corruption can be detected.
+    pub fn describe(&self) -> String {
+        let mut s = if self.chunks == 0 {
+            "no chunks".to_string()
+        } else if self.with_crc == self.chunks {
+            format!("all {} chunks carry a CRC", self.chunks)
+        } else if self.with_crc == 0 {
+            format!(
+                "none of the {} chunks carries a CRC (0 = not computed): corruption cannot be detected",
+                self.chunks
+            )
+        } else {
+            format!(
+                "{} of {} chunks carry no CRC: corruption in them cannot be detected",
+                self.chunks - self.with_crc,
+                self.chunks
+            )
+        };
+        if self.unchunked_messages {
+            s.push_str("; messages outside chunks carry no CRC: corruption cannot be detected");
+        }
+        s
+    }
+
+    /// True when some data cannot be checked for corruption.
+    pub fn incomplete(&self) -> bool {
+        self.with_crc < self.chunks || self.unchunked_messages
+    }
+}
 
 /// An open session log. Cheap to share; each [`SessionLog::messages`] call opens its own
 /// file handle.
@@ -47,8 +89,39 @@ impl SessionLog {
         }
         let summary = match index::read_summary_section(&mut file, file_len).map_err(err)? {
             Some(s) if index::summary_is_complete(&s) => s,
-            _ => index::linear_index(&mut file, file_len).map_err(err)?,
+            Some(claimed) => {
+                // no chunk index: the statistics alone are not believed over the data
+                let mut found = index::linear_index(&mut file, file_len).map_err(err)?;
+                let count = |s: &LogSummary| s.statistics.as_ref().map_or(0, |st| st.message_count);
+                if count(&claimed) != count(&found) {
+                    found.warnings.push(format!(
+                        "the summary section says {} messages and has no chunk index; a linear \
+                         scan of the data found {}, and the index was rebuilt from the data",
+                        count(&claimed),
+                        count(&found)
+                    ));
+                }
+                found
+            }
+            None => index::linear_index(&mut file, file_len).map_err(err)?,
         };
+        Ok(SessionLog { path, summary })
+    }
+
+    /// Open a damaged log (`--recover`): index it front to back, leaving out chunks that do
+    /// not open and stopping where the file is cut or its records lose their framing. What
+    /// was lost is said in [`LogSummary::warnings`]; the messages read are the complete ones
+    /// before the damage (and in any good chunk after a bad one).
+    pub fn open_recovering(path: impl AsRef<Path>) -> Result<SessionLog, LogError> {
+        let path = path.as_ref().to_path_buf();
+        let err = |k: LogErrorKind| LogError::new(&path, k);
+        let mut file = File::open(&path).map_err(|e| err(e.into()))?;
+        let file_len = file.metadata().map_err(|e| err(e.into()))?.len();
+        let mut magic = [0u8; 8];
+        if file_len < 8 || file.read_exact(&mut magic).is_err() || &magic != records::MAGIC {
+            return Err(err(LogErrorKind::NotMcap));
+        }
+        let summary = index::recovering_index(&mut file, file_len).map_err(err)?;
         Ok(SessionLog { path, summary })
     }
 
@@ -58,6 +131,27 @@ impl SessionLog {
 
     pub fn summary(&self) -> &LogSummary {
         &self.summary
+    }
+
+    /// Whether the log can detect corruption: of its chunks, how many carry a CRC (rosbags
+    /// writes 0 = "not computed"). Reads each chunk's fixed header only.
+    pub fn crc_coverage(&self) -> Result<CrcCoverage, LogError> {
+        let err = |k: LogErrorKind| LogError::new(&self.path, k);
+        let mut file = File::open(&self.path).map_err(|e| err(e.into()))?;
+        let mut out = CrcCoverage {
+            chunks: self.summary.chunks.len(),
+            with_crc: 0,
+            unchunked_messages: self.summary.unchunked_messages,
+        };
+        for c in &self.summary.chunks {
+            // opcode + length, then start, end, uncompressed size (u64 each) and the CRC
+            let head = io::read_at(&mut file, c.offset, 9 + 28, self.summary.file_len, "chunk")
+                .map_err(err)?;
+            if head[9 + 24..9 + 28] != [0, 0, 0, 0] {
+                out.with_crc += 1;
+            }
+        }
+        Ok(out)
     }
 
     /// Every message, in log-time order.

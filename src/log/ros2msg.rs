@@ -22,6 +22,10 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
+mod nesting;
+
+pub use nesting::{MAX_NESTING, min_wire_size};
+
 /// A numeric or boolean primitive of the ROS 2 interface language.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Prim {
@@ -159,12 +163,15 @@ pub struct Registry {
     pub defs: Vec<MsgDef>,
     /// Index of the schema's own (root) type.
     pub root: usize,
+    /// The fewest bytes one instance of each type takes on the wire (0 for a type of
+    /// zero-length arrays only). A schema whose size overflows `usize` does not parse.
+    pub min_size: Vec<usize>,
 }
 
 /// A definition that does not parse: which type block, which line (1-based within the whole
-/// schema text), and why.
+/// schema text; 0 when the fault is not on one line), and why.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("schema {type_name}, line {line}: {reason}")]
+#[error("schema {type_name}{}: {reason}", if *line == 0 { String::new() } else { format!(", line {line}") })]
 pub struct SchemaError {
     pub type_name: String,
     pub line: usize,
@@ -268,45 +275,16 @@ impl Registry {
                 constants: def.constants.clone(),
             });
         }
-        let registry = Registry { defs, root: 0 };
-        registry.check_acyclic()?;
-        Ok(registry)
+        let measures = nesting::measure(&defs)?;
+        Ok(Registry {
+            defs,
+            root: 0,
+            min_size: measures.min_size,
+        })
     }
 
     pub fn root_def(&self) -> &MsgDef {
         &self.defs[self.root]
-    }
-
-    /// A type that contains itself (directly or not) has no finite CDR encoding.
-    fn check_acyclic(&self) -> Result<(), SchemaError> {
-        // 0 = unvisited, 1 = on the stack, 2 = done
-        fn visit(reg: &Registry, i: usize, state: &mut [u8]) -> Result<(), SchemaError> {
-            match state[i] {
-                2 => return Ok(()),
-                1 => {
-                    return Err(SchemaError {
-                        type_name: reg.defs[i].name.clone(),
-                        line: 0,
-                        reason: "type contains itself".into(),
-                    });
-                }
-                _ => {}
-            }
-            state[i] = 1;
-            for f in &reg.defs[i].fields {
-                // A sequence of itself could be empty, but ROS forbids recursive types anyway.
-                if let BaseType::Msg(j) = f.ty {
-                    visit(reg, j, state)?;
-                }
-            }
-            state[i] = 2;
-            Ok(())
-        }
-        let mut state = vec![0u8; self.defs.len()];
-        for i in 0..self.defs.len() {
-            visit(self, i, &mut state)?;
-        }
-        Ok(())
     }
 }
 
@@ -695,90 +673,4 @@ fn split_array_items(inner: &str) -> Result<Vec<String>, String> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    const LASER_SCAN: &str = "std_msgs/Header header\nfloat32 angle_min\nfloat32[] ranges\n\
-================================================================================\n\
-MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n\
-================================================================================\n\
-MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n";
-
-    #[test]
-    fn parses_rosbag2_layout_and_resolves_nested_types() {
-        let reg = Registry::parse("sensor_msgs/msg/LaserScan", LASER_SCAN).expect("parses");
-        assert_eq!(reg.defs.len(), 3);
-        let root = reg.root_def();
-        assert_eq!(root.name, "sensor_msgs/msg/LaserScan");
-        assert_eq!(root.fields.len(), 3);
-        let BaseType::Msg(h) = root.fields[0].ty else {
-            panic!("header is a message")
-        };
-        assert_eq!(reg.defs[h].name, "std_msgs/msg/Header");
-        assert_eq!(root.fields[2].array, ArrayKind::Unbounded);
-        assert_eq!(root.fields[2].ty, BaseType::Prim(Prim::F32));
-    }
-
-    #[test]
-    fn parses_arrays_bounds_defaults_and_constants() {
-        let text = "int8 MODE_A=1\nstring NAME = \"a # b\" # comment\nuint8[<=4] b [1, 2]\n\
-                    float64[3] v [0.5, -1, 2e3]\nstring<=5 s 'hi'\nbool flag true\nwstring w\nint32 x -7 # c";
-        let reg = Registry::parse("p/T", text).expect("parses");
-        let d = reg.root_def();
-        assert_eq!(d.constants.len(), 2);
-        assert_eq!(d.constants[0].value, Literal::Int(1));
-        assert_eq!(d.constants[1].value, Literal::Str("a # b".into()));
-        assert_eq!(d.fields[0].array, ArrayKind::Bounded(4));
-        assert_eq!(
-            d.fields[0].default,
-            Some(Literal::Array(vec![Literal::Int(1), Literal::Int(2)]))
-        );
-        assert_eq!(d.fields[1].array, ArrayKind::Fixed(3));
-        assert_eq!(
-            d.fields[1].default,
-            Some(Literal::Array(vec![
-                Literal::Float(0.5),
-                Literal::Float(-1.0),
-                Literal::Float(2000.0)
-            ]))
-        );
-        assert_eq!(d.fields[2].ty, BaseType::String { bound: Some(5) });
-        assert_eq!(d.fields[2].default, Some(Literal::Str("hi".into())));
-        assert_eq!(d.fields[3].default, Some(Literal::Bool(true)));
-        assert_eq!(d.fields[4].ty, BaseType::WString { bound: None });
-        assert_eq!(d.fields[5].default, Some(Literal::Int(-7)));
-    }
-
-    #[test]
-    fn bare_names_resolve_within_the_package_and_header_to_std_msgs() {
-        let text = "Header header\nInner i\n===\nMSG: p/Inner\nint8 a\n===\nMSG: std_msgs/Header\nuint32 seq";
-        let reg = Registry::parse("p/msg/Outer", text).expect("parses");
-        assert_eq!(reg.defs.len(), 3);
-    }
-
-    fn check_err(text: &str, line: usize, needle: &str) {
-        let e = Registry::parse("p/T", text).expect_err("must not parse");
-        assert_eq!(e.line, line, "{e}");
-        assert!(e.reason.contains(needle), "{e}");
-    }
-
-    #[test]
-    fn reports_the_line_of_each_kind_of_mistake() {
-        check_err("int32 a\nflot32 b", 2, "flot32");
-        check_err("int32", 1, "no name");
-        check_err("int32[ a", 1, "closing");
-        check_err("int32[x] a", 1, "bound");
-        check_err("uint8 a 300", 1, "does not fit");
-        check_err("bool b maybe", 1, "not a bool");
-        check_err("float64[2] v [1]", 1, "elements");
-        check_err("string s \"open", 1, "unterminated");
-        check_err("int32 9a", 1, "valid");
-        check_err("int8 a\n===\nNOPE", 3, "MSG:");
-    }
-
-    #[test]
-    fn rejects_recursive_types() {
-        let e = Registry::parse("p/T", "p/T self").expect_err("recursive");
-        assert!(e.reason.contains("itself"));
-    }
-}
+mod tests;

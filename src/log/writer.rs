@@ -137,12 +137,12 @@ impl SessionWriter {
         let (schema_id, registry) = match self.registries.get(type_name) {
             Some(x) => x.clone(),
             None => {
-                let reg = Registry::parse(type_name, definition).map_err(|source| {
+                let reg = Registry::parse(type_name, definition).map_err(|error| {
                     LogError::new(
                         &self.path,
                         LogErrorKind::Schema {
                             schema: type_name.to_string(),
-                            source,
+                            error,
                         },
                     )
                 })?;

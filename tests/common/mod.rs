@@ -23,3 +23,5 @@ pub fn real(rel: &str) -> Option<PathBuf> {
 pub fn laser_log(name: &str) -> Option<PathBuf> {
     real(&format!("laser/{name}/{name}.mcap"))
 }
+
+pub mod raw_mcap;

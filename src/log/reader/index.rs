@@ -14,11 +14,12 @@ use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::sync::Arc;
 
 use super::super::error::LogErrorKind;
+use super::chunk::{Keep, open_chunk_keeping};
 use super::io::read_at;
 use super::records::{
     ChannelInfo, ChunkInfo, Cursor, MAGIC, MetadataRecord, RECORD_HEAD_LEN, SchemaInfo, Statistics,
-    add_channel, bad, op, open_chunk, parse_channel, parse_chunk_index, parse_message_header,
-    parse_metadata, parse_schema, parse_statistics, record_head, record_name, records,
+    add_channel, bad, op, parse_channel, parse_chunk_index, parse_message_header, parse_metadata,
+    parse_schema, parse_statistics, record_head, record_name, records,
 };
 use crate::time::Nanos;
 
@@ -37,6 +38,8 @@ pub struct LogSummary {
     /// True if some messages are stored outside chunks.
     pub unchunked_messages: bool,
     pub file_len: u64,
+    /// Where the file's own index disagreed with its data (and the data was believed).
+    pub warnings: Vec<String>,
 }
 
 impl LogSummary {
@@ -56,15 +59,11 @@ impl LogSummary {
     }
 }
 
-/// A summary is usable if it indexes the chunks, or says the messages are outside chunks (read
-/// in file order), or says there are none. Without statistics and chunk indexes it tells too
-/// little, and the index is rebuilt by a linear pass.
+/// A summary is usable if it indexes the chunks or says the messages are outside chunks (read
+/// in file order). Without chunk indexes and with statistics of no messages it may be true
+/// (an empty log) or a lie hiding the data; a linear pass over the (then small) file tells.
 pub(super) fn summary_is_complete(s: &LogSummary) -> bool {
-    s.unchunked_messages
-        || !s.chunks.is_empty()
-        || s.statistics
-            .as_ref()
-            .is_some_and(|st| st.message_count == 0)
+    s.unchunked_messages || !s.chunks.is_empty()
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -330,8 +329,12 @@ impl LinearIndex {
 
     /// Index a chunk: decompress it once, register its schemas and channels, count messages.
     fn chunk(&mut self, body: &[u8], pos: u64, len: u64) -> Result<(), LogErrorKind> {
-        let chunk = open_chunk(body, pos, &self.summary.channels, None)?;
+        // only the messages' headers are kept: the pass needs channels and times
+        let chunk = open_chunk_keeping(body, pos, &self.summary.channels, None, &mut |_| {
+            Keep::Header
+        })?;
         let mut ids = BTreeSet::new();
+        let mut span: Option<(Nanos, Nanos)> = None;
         for rec in records(&chunk.data) {
             let (op_in, b, _) = rec.map_err(bad("chunk", pos))?;
             let summary = &mut self.summary;
@@ -347,16 +350,26 @@ impl LinearIndex {
                 op::MESSAGE => {
                     let h = parse_message_header(b).map_err(bad("message in chunk", pos))?;
                     ids.insert(h.channel);
-                    self.count(h.channel, Nanos(h.log_time));
+                    let t = Nanos(h.log_time);
+                    span = Some(span.map_or((t, t), |(a, b)| (a.min(t), b.max(t))));
+                    self.count(h.channel, t);
                 }
                 _ => {}
             }
         }
+        // the merge orders chunks by their messages' real times, not the header's claim
+        let (start, end) = span.unwrap_or((chunk.start, chunk.end));
+        if start < chunk.start || end > chunk.end {
+            self.summary.warnings.push(format!(
+                "chunk at byte {pos} declares {}..{} s, its messages lie in {start}..{end} s",
+                chunk.start, chunk.end
+            ));
+        }
         self.summary.chunks.push(ChunkInfo {
             offset: pos,
             length: RECORD_HEAD_LEN as u64 + len,
-            start: chunk.start,
-            end: chunk.end,
+            start,
+            end,
             compression: chunk.compression,
             channels: Some(ids),
         });
@@ -374,14 +387,26 @@ impl LinearIndex {
 
 /// Build the index by reading the file front to back (no usable summary section).
 pub(super) fn linear_index(file: &mut File, file_len: u64) -> Result<LogSummary, LogErrorKind> {
+    linear_pass(file, file_len, false)
+}
+
+/// [`linear_index`] for `--recover`: a chunk that does not open (CRC, decompression, a bad
+/// record inside) is skipped, and a cut or corrupt record framing ends the index there; each
+/// loss is said in [`LogSummary::warnings`] (bytes, time span where known, last good message).
+/// The stream then reads only what was indexed.
+pub(super) fn recovering_index(file: &mut File, file_len: u64) -> Result<LogSummary, LogErrorKind> {
+    linear_pass(file, file_len, true)
+}
+
+fn linear_pass(file: &mut File, file_len: u64, recover: bool) -> Result<LogSummary, LogErrorKind> {
     let mut index = LinearIndex::new(file_len);
     let mut reader = BufReader::with_capacity(1 << 16, &mut *file);
     reader.seek(SeekFrom::Start(8))?;
     let mut pos = 8u64;
     let head_len = RECORD_HEAD_LEN as u64;
     loop {
-        if pos + head_len > file_len {
-            return Err(LogErrorKind::Truncated {
+        let cut = if pos + head_len > file_len {
+            Some(LogErrorKind::Truncated {
                 what: if pos == file_len {
                     "footer record"
                 } else {
@@ -391,19 +416,27 @@ pub(super) fn linear_index(file: &mut File, file_len: u64) -> Result<LogSummary,
                 needed: head_len,
                 file_len,
                 last: index.last_named(),
-            });
-        }
+            })
+        } else {
+            None
+        };
         let mut head = [0u8; RECORD_HEAD_LEN];
-        reader.read_exact(&mut head)?;
-        let (opcode, len) = record_head(&head);
+        let (opcode, len) = match cut {
+            Some(e) => return index.damaged(e, pos, recover),
+            None => {
+                reader.read_exact(&mut head)?;
+                record_head(&head)
+            }
+        };
         if len > file_len - pos - head_len {
-            return Err(LogErrorKind::Truncated {
+            let e = LogErrorKind::Truncated {
                 what: record_name(opcode),
                 offset: pos,
                 needed: len.saturating_add(head_len),
                 file_len,
                 last: index.last_named(),
-            });
+            };
+            return index.damaged(e, pos, recover);
         }
         if opcode == op::FOOTER {
             // a complete file ends with the footer and the closing magic
@@ -412,24 +445,63 @@ pub(super) fn linear_index(file: &mut File, file_len: u64) -> Result<LogSummary,
             reader.seek_relative(len as i64)?;
             (&mut reader).take(8).read_to_end(&mut tail)?;
             if tail.as_slice() != MAGIC {
-                return Err(LogErrorKind::Truncated {
+                let e = LogErrorKind::Truncated {
                     what: "closing magic",
                     offset: end,
                     needed: 8,
                     file_len,
                     last: index.last_named(),
-                });
+                };
+                return index.damaged(e, end, recover);
             }
             break;
         }
         if LinearIndex::needs_body(opcode) {
             let mut body = vec![0u8; len as usize];
             reader.read_exact(&mut body)?;
-            index.record(opcode, &body, pos, len)?;
+            match index.record(opcode, &body, pos, len) {
+                Err(e) if recover && opcode == op::CHUNK => index.skip_chunk(e, &body, pos, len),
+                other => other?,
+            }
         } else {
             reader.seek_relative(len as i64)?;
         }
         pos += head_len + len;
     }
     Ok(index.finish())
+}
+
+impl LinearIndex {
+    /// The file is damaged at byte `at`: an error, or (recovering) the index so far with
+    /// the loss said and the file treated as ending there.
+    fn damaged(
+        mut self,
+        e: LogErrorKind,
+        at: u64,
+        recover: bool,
+    ) -> Result<LogSummary, LogErrorKind> {
+        if !recover {
+            return Err(e);
+        }
+        // the error names the last complete message
+        let file_len = self.summary.file_len;
+        self.summary.warnings.push(format!(
+            "recovered: {e}; bytes {at}..{file_len} ({} bytes) are lost",
+            file_len - at
+        ));
+        self.summary.file_len = at;
+        Ok(self.finish())
+    }
+
+    /// Recovering: a chunk that does not open is left out, and its loss said.
+    fn skip_chunk(&mut self, e: LogErrorKind, body: &[u8], pos: u64, len: u64) {
+        let span = match super::records::parse_chunk(body) {
+            Ok(h) => format!(", declared {}..{} s", Nanos(h.start), Nanos(h.end)),
+            Err(_) => String::new(),
+        };
+        self.summary.warnings.push(format!(
+            "recovered: the chunk at byte {pos} ({} bytes{span}) is skipped: {e}",
+            len + RECORD_HEAD_LEN as u64
+        ));
+    }
 }

@@ -18,12 +18,12 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use super::super::error::{LogError, LogErrorKind};
+use super::chunk::{Keep, open_chunk_keeping};
 use super::index::LogSummary;
 use super::io::read_at;
 use super::records::{
     ChannelInfo, ChunkInfo, MESSAGE_HEADER_LEN, RECORD_HEAD_LEN, SchemaInfo, add_channel, bad, op,
-    open_chunk, parse_channel, parse_message_header, parse_schema, record_head, record_name,
-    records,
+    parse_channel, parse_message_header, parse_schema, record_head, record_name, records,
 };
 use crate::time::Nanos;
 
@@ -91,18 +91,24 @@ impl Catalog {
     /// Decompress a chunk body, register its schemas/channels, and index its wanted messages.
     fn load(&mut self, body: &[u8], chunk: &ChunkInfo) -> Result<Slot, LogErrorKind> {
         let chunk_offset = chunk.offset;
-        let opened = open_chunk(body, chunk_offset, &self.channels, chunk.channels.as_ref())?;
-        let (start, end) = (opened.start, opened.end);
-        if chunk.length > 0 && (start, end) != (chunk.start, chunk.end) {
-            return Err(LogErrorKind::BadRecord {
-                record: "chunk",
-                offset: chunk_offset,
-                reason: format!(
-                    "header time range {start}..{end} s differs from the index's {}..{} s",
-                    chunk.start, chunk.end
-                ),
-            });
-        }
+        // a channel defined inside this chunk is not known yet: keep its messages, the loop
+        // below filters them
+        let mut keep = |ch: u16| {
+            if self.topics.is_none() || !self.channels.contains_key(&ch) || self.wants(ch) {
+                Keep::Whole
+            } else {
+                Keep::Skip
+            }
+        };
+        // The declared time ranges (index and header) are not trusted: the merge checks the
+        // messages' own times as it goes (`Indexed::next`).
+        let opened = open_chunk_keeping(
+            body,
+            chunk_offset,
+            &self.channels,
+            chunk.channels.as_ref(),
+            &mut keep,
+        )?;
         let data = opened.data;
         let mut entries = Vec::new();
         for rec in records(&data) {
@@ -185,8 +191,15 @@ impl Catalog {
     }
 }
 
+/// Most bytes of wanted messages held at once from chunks that overlap in time: beyond it a
+/// log is refused with an error rather than exhausting memory. 1 GiB is some forty 4K RGB
+/// images in flight; real logs hold a chunk or two (a few MiB) at a time.
+const MAX_HELD_BYTES: usize = 1 << 30;
+
 /// The k-way merge of indexed chunks by log time.
 struct ChunkMerge {
+    /// Bytes of the loaded chunks' kept records.
+    held: usize,
     /// Chunks not loaded yet, latest start time first (popped from the back).
     pending: Vec<ChunkInfo>,
     slots: Vec<Option<Slot>>,
@@ -199,6 +212,7 @@ impl ChunkMerge {
         pending.sort_by_key(|c| (c.start, c.offset));
         pending.reverse(); // pop from the back
         ChunkMerge {
+            held: 0,
             pending,
             slots: Vec::new(),
             heap: BinaryHeap::new(),
@@ -227,6 +241,7 @@ impl ChunkMerge {
                 }
             };
             self.heap.push(Reverse((t, slot.chunk_offset, at, i)));
+            self.held += slot.buf.len();
             self.slots[i] = Some(slot);
         }
     }
@@ -242,6 +257,7 @@ impl ChunkMerge {
         if let Some(&(t, next_at)) = slot.entries.get(slot.next) {
             self.heap.push(Reverse((t, chunk_offset, next_at, i)));
         } else {
+            self.held -= slot.buf.len();
             self.slots[i] = None; // last message of the chunk: free it once the caller drops it
         }
         Some((buf, at, chunk_offset))
@@ -252,6 +268,8 @@ impl ChunkMerge {
 struct Indexed {
     file: File,
     merge: ChunkMerge,
+    /// Log time of the latest message handed out.
+    yielded: Option<u64>,
 }
 
 /// Records read front to back (messages outside chunks).
@@ -309,6 +327,7 @@ impl MessageStream {
             Mode::Indexed(Indexed {
                 file,
                 merge: ChunkMerge::new(pending),
+                yielded: None,
             })
         };
         MessageStream {
@@ -341,12 +360,36 @@ impl Indexed {
                 "chunk record",
             )?;
             let slot = catalog.load(chunk_body(&rec, &chunk)?, &chunk)?;
+            // The merge loads a chunk by its declared start; a message before it is still
+            // merged in order unless a later one was already handed out.
+            if let (Some(&(first, _)), Some(previous)) = (slot.entries.first(), self.yielded)
+                && first < previous
+            {
+                return Err(LogErrorKind::ChunkStartsEarlier {
+                    offset: chunk.offset,
+                    start: chunk.start,
+                    this: Nanos(first),
+                    previous: Nanos(previous),
+                });
+            }
             self.merge.insert(slot);
+            if self.merge.held > MAX_HELD_BYTES {
+                return Err(LogErrorKind::BadRecord {
+                    record: "chunk",
+                    offset: chunk.offset,
+                    reason: format!(
+                        "chunks overlapping in time up to {} s hold {} bytes of messages at                          once, more than the {MAX_HELD_BYTES} byte budget",
+                        chunk.end, self.merge.held
+                    ),
+                });
+            }
         }
         match self.merge.pop() {
-            Some((buf, at, chunk_offset)) => catalog
-                .message_at(&buf, at as usize, chunk_offset)
-                .map(Some),
+            Some((buf, at, chunk_offset)) => {
+                let m = catalog.message_at(&buf, at as usize, chunk_offset)?;
+                self.yielded = Some(m.log_time.0);
+                Ok(Some(m))
+            }
             None => Ok(None),
         }
     }

@@ -1,11 +1,13 @@
 //! Pure MCAP record parsing: bytes in, records out. No files and no I/O — every function here
 //! works on a `&[u8]`, checks each length before using it, and answers a reason string (the
 //! callers wrap it in a [`LogErrorKind`] naming the record and its byte offset). Chunk bodies
-//! are decompressed and their CRCs verified here too, since that is a function of the bytes.
+//! are decompressed and their CRCs verified in [`super::chunk`].
 
 use std::collections::{BTreeMap, BTreeSet};
-use std::io::Read;
 use std::sync::Arc;
+
+#[cfg(test)]
+use super::chunk::open_chunk;
 
 use super::super::error::LogErrorKind;
 use crate::time::Nanos;
@@ -29,9 +31,6 @@ pub(super) mod op {
     pub const METADATA: u8 = 0x0C;
     pub const METADATA_INDEX: u8 = 0x0D;
 }
-
-/// Largest decompressed chunk we accept (a corrupt size field must not exhaust memory).
-const MAX_CHUNK_BYTES: u64 = 1 << 31;
 
 /// A schema record.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -387,109 +386,6 @@ pub(super) fn record_name(opcode: u8) -> &'static str {
         0x0F => "data end record",
         _ => "record of unknown type",
     }
-}
-
-/// A chunk's records, decompressed and CRC-checked.
-pub(super) struct OpenChunk {
-    pub(super) start: Nanos,
-    pub(super) end: Nanos,
-    pub(super) compression: String,
-    pub(super) data: Vec<u8>,
-}
-
-/// Decompress a chunk record body (as read from `offset`) and verify its CRC. `ids` (the
-/// chunk's channels, when the index knows them) name the topics in errors.
-pub(super) fn open_chunk(
-    body: &[u8],
-    offset: u64,
-    channels: &BTreeMap<u16, Arc<ChannelInfo>>,
-    ids: Option<&BTreeSet<u16>>,
-) -> Result<OpenChunk, LogErrorKind> {
-    let h = parse_chunk(body).map_err(bad("chunk", offset))?;
-    let topics = || match ids {
-        Some(ids) => ids
-            .iter()
-            .filter_map(|id| channels.get(id).map(|c| c.topic.clone()))
-            .collect::<Vec<_>>()
-            .join(", "),
-        None => "unknown topics".to_string(),
-    };
-    if h.uncompressed_size > MAX_CHUNK_BYTES {
-        return Err(LogErrorKind::BadRecord {
-            record: "chunk",
-            offset,
-            reason: format!(
-                "uncompressed size {} exceeds the {} byte limit",
-                h.uncompressed_size, MAX_CHUNK_BYTES
-            ),
-        });
-    }
-    let want = h.uncompressed_size;
-    let fail = |reason: String| LogErrorKind::Decompress {
-        offset,
-        start: Nanos(h.start),
-        end: Nanos(h.end),
-        topics: topics(),
-        compression: h.compression.clone(),
-        reason,
-    };
-    let data = match h.compression.as_str() {
-        "" => h.records.to_vec(),
-        // Sizes up to 256 MiB are trusted enough to allocate up front and decompress in one
-        // call; larger claims stream, so a corrupt size cannot reserve gigabytes.
-        "zstd" if want <= 1 << 28 => {
-            let mut out = Vec::with_capacity(want as usize);
-            zstd::bulk::Decompressor::new()
-                .and_then(|mut d| d.decompress_to_buffer(h.records, &mut out))
-                .map_err(|e| fail(e.to_string()))?;
-            out
-        }
-        "zstd" => {
-            let mut out = Vec::new();
-            zstd::stream::read::Decoder::new(h.records)
-                .and_then(|d| d.take(want + 1).read_to_end(&mut out))
-                .map_err(|e| fail(e.to_string()))?;
-            out
-        }
-        "lz4" => {
-            let mut out = Vec::new();
-            lz4::Decoder::new(h.records)
-                .and_then(|d| d.take(want + 1).read_to_end(&mut out))
-                .map_err(|e| fail(e.to_string()))?;
-            out
-        }
-        other => {
-            return Err(LogErrorKind::UnsupportedCompression {
-                offset,
-                compression: other.to_string(),
-            });
-        }
-    };
-    if data.len() as u64 != want {
-        return Err(fail(format!(
-            "gave {} bytes, the header says {want}",
-            data.len()
-        )));
-    }
-    if h.crc != 0 {
-        let computed = crc32fast::hash(&data);
-        if computed != h.crc {
-            return Err(LogErrorKind::ChunkCrc {
-                offset,
-                start: Nanos(h.start),
-                end: Nanos(h.end),
-                topics: topics(),
-                stored: h.crc,
-                computed,
-            });
-        }
-    }
-    Ok(OpenChunk {
-        start: Nanos(h.start),
-        end: Nanos(h.end),
-        compression: h.compression,
-        data,
-    })
 }
 
 #[cfg(test)]

@@ -1,0 +1,247 @@
+//! Opening a chunk record: its records are decompressed as a stream and walked record by
+//! record, and only what the reader asked to keep is held — schemas, channels and the wanted
+//! messages (whole, or only their fixed header for the linear index pass). A chunk that
+//! declares 2 GiB (a zstd bomb, or a big chunk of which one small topic is wanted) never
+//! takes 2 GiB: memory is what is kept, not what the chunk holds. The CRC is computed over
+//! every byte as it streams past, so nothing kept is handed out before it is verified.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::io::{self, BufReader, Read};
+use std::sync::Arc;
+
+use super::super::error::LogErrorKind;
+use super::records::{
+    ChannelInfo, MESSAGE_HEADER_LEN, RECORD_HEAD_LEN, bad, op, parse_chunk, parse_message_header,
+    record_head,
+};
+use crate::time::Nanos;
+
+/// Largest decompressed chunk we accept (a corrupt size field must not run for ever).
+const MAX_CHUNK_BYTES: u64 = 1 << 31;
+
+/// Largest schema or channel record inside a chunk (real ones are a few KB of text).
+const MAX_DEFINITION_BYTES: u64 = 16 << 20;
+
+/// What to keep of one message record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Keep {
+    Whole,
+    /// Only the channel, sequence and times (the record's length then says 22 bytes).
+    Header,
+    Skip,
+}
+
+/// A chunk's kept records, decompressed and CRC-checked, in the chunk's record format.
+pub(super) struct OpenChunk {
+    pub(super) start: Nanos,
+    pub(super) end: Nanos,
+    pub(super) compression: String,
+    pub(super) data: Vec<u8>,
+}
+
+/// Decompress a chunk record body (as read from `offset`), keep every record, and verify its
+/// CRC. `ids` (the chunk's channels, when the index knows them) name the topics in errors.
+#[cfg(test)]
+pub(super) fn open_chunk(
+    body: &[u8],
+    offset: u64,
+    channels: &BTreeMap<u16, Arc<ChannelInfo>>,
+    ids: Option<&BTreeSet<u16>>,
+) -> Result<OpenChunk, LogErrorKind> {
+    open_chunk_keeping(body, offset, channels, ids, &mut |_| Keep::Whole)
+}
+
+/// A reader that counts and checksums the bytes read through it.
+struct Tally<R> {
+    inner: R,
+    crc: crc32fast::Hasher,
+    count: u64,
+}
+
+impl<R: Read> Read for Tally<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.crc.update(&buf[..n]);
+        self.count += n as u64;
+        Ok(n)
+    }
+}
+
+/// [`open_chunk`], keeping of each message what `keep(channel id)` says.
+pub(super) fn open_chunk_keeping(
+    body: &[u8],
+    offset: u64,
+    channels: &BTreeMap<u16, Arc<ChannelInfo>>,
+    ids: Option<&BTreeSet<u16>>,
+    keep: &mut dyn FnMut(u16) -> Keep,
+) -> Result<OpenChunk, LogErrorKind> {
+    let h = parse_chunk(body).map_err(bad("chunk", offset))?;
+    let topics = || match ids {
+        Some(ids) => ids
+            .iter()
+            .filter_map(|id| channels.get(id).map(|c| c.topic.clone()))
+            .collect::<Vec<_>>()
+            .join(", "),
+        None => "unknown topics".to_string(),
+    };
+    let want = h.uncompressed_size;
+    if want > MAX_CHUNK_BYTES {
+        return Err(LogErrorKind::BadRecord {
+            record: "chunk",
+            offset,
+            reason: format!("uncompressed size {want} exceeds the {MAX_CHUNK_BYTES} byte limit"),
+        });
+    }
+    let fail = |reason: String| LogErrorKind::Decompress {
+        offset,
+        start: Nanos(h.start),
+        end: Nanos(h.end),
+        topics: topics(),
+        compression: h.compression.clone(),
+        reason,
+    };
+    let inner: Box<dyn Read + '_> = match h.compression.as_str() {
+        "" => Box::new(h.records),
+        "zstd" => Box::new(BufReader::with_capacity(
+            1 << 16,
+            zstd::stream::read::Decoder::with_buffer(h.records).map_err(|e| fail(e.to_string()))?,
+        )),
+        "lz4" => Box::new(BufReader::with_capacity(
+            1 << 16,
+            lz4::Decoder::new(h.records).map_err(|e| fail(e.to_string()))?,
+        )),
+        other => {
+            return Err(LogErrorKind::UnsupportedCompression {
+                offset,
+                compression: other.to_string(),
+            });
+        }
+    };
+    let mut r = Tally {
+        inner,
+        crc: crc32fast::Hasher::new(),
+        count: 0,
+    };
+    let data = walk(&mut r, want, keep).map_err(|e| match e {
+        Walk::Io(e) if e.kind() == io::ErrorKind::UnexpectedEof => {
+            fail(format!("gave {} bytes, the header says {want}", r.count))
+        }
+        Walk::Io(e) => fail(e.to_string()),
+        Walk::Bad(reason) => bad("chunk", offset)(reason),
+    })?;
+    // the declared size must be the whole stream
+    let mut extra = [0u8; 1];
+    if r.read(&mut extra).map_err(|e| fail(e.to_string()))? > 0 {
+        return Err(fail(format!(
+            "gave more bytes than the {want} the header says"
+        )));
+    }
+    if h.crc != 0 {
+        let computed = r.crc.finalize();
+        if computed != h.crc {
+            return Err(LogErrorKind::ChunkCrc {
+                offset,
+                start: Nanos(h.start),
+                end: Nanos(h.end),
+                topics: topics(),
+                stored: h.crc,
+                computed,
+            });
+        }
+    }
+    Ok(OpenChunk {
+        start: Nanos(h.start),
+        end: Nanos(h.end),
+        compression: h.compression,
+        data,
+    })
+}
+
+enum Walk {
+    Io(io::Error),
+    Bad(String),
+}
+
+impl From<io::Error> for Walk {
+    fn from(e: io::Error) -> Walk {
+        Walk::Io(e)
+    }
+}
+
+/// Read `want` bytes of records from `r`, keeping definitions and the messages `keep` wants.
+fn walk<R: Read>(
+    r: &mut Tally<R>,
+    want: u64,
+    keep: &mut dyn FnMut(u16) -> Keep,
+) -> Result<Vec<u8>, Walk> {
+    let mut out = Vec::new();
+    while r.count < want {
+        let at = r.count;
+        let mut head = [0u8; RECORD_HEAD_LEN];
+        r.read_exact(&mut head)?;
+        let (opcode, len) = record_head(&head);
+        let left = want - r.count;
+        if len > left {
+            return Err(Walk::Bad(format!(
+                "record at chunk byte {at} claims {len} bytes, {left} left"
+            )));
+        }
+        match opcode {
+            op::SCHEMA | op::CHANNEL => {
+                if len > MAX_DEFINITION_BYTES {
+                    return Err(Walk::Bad(format!(
+                        "definition record at chunk byte {at} claims {len} bytes (at most \
+                         {MAX_DEFINITION_BYTES})"
+                    )));
+                }
+                out.extend_from_slice(&head);
+                read_into(r, len, &mut out)?;
+            }
+            op::MESSAGE if len >= MESSAGE_HEADER_LEN as u64 => {
+                let mut fixed = [0u8; MESSAGE_HEADER_LEN];
+                r.read_exact(&mut fixed)?;
+                let channel = parse_message_header(&fixed).map_err(Walk::Bad)?.channel;
+                let rest = len - MESSAGE_HEADER_LEN as u64;
+                match keep(channel) {
+                    Keep::Whole => {
+                        out.extend_from_slice(&head);
+                        out.extend_from_slice(&fixed);
+                        read_into(r, rest, &mut out)?;
+                    }
+                    Keep::Header => {
+                        out.push(op::MESSAGE);
+                        out.extend_from_slice(&(MESSAGE_HEADER_LEN as u64).to_le_bytes());
+                        out.extend_from_slice(&fixed);
+                        skip(r, rest)?;
+                    }
+                    Keep::Skip => skip(r, rest)?,
+                }
+            }
+            op::MESSAGE => {
+                return Err(Walk::Bad(format!(
+                    "message record at chunk byte {at} has {len} bytes, fewer than its \
+                     {MESSAGE_HEADER_LEN}-byte header"
+                )));
+            }
+            _ => skip(r, len)?,
+        }
+    }
+    Ok(out)
+}
+
+/// Append exactly `len` bytes of `r` to `out` (growing as they arrive, not up front).
+fn read_into<R: Read>(r: &mut R, len: u64, out: &mut Vec<u8>) -> io::Result<()> {
+    let got = r.take(len).read_to_end(out)?;
+    if (got as u64) < len {
+        return Err(io::ErrorKind::UnexpectedEof.into());
+    }
+    Ok(())
+}
+
+fn skip<R: Read>(r: &mut R, len: u64) -> io::Result<()> {
+    let got = io::copy(&mut r.take(len), &mut io::sink())?;
+    if got < len {
+        return Err(io::ErrorKind::UnexpectedEof.into());
+    }
+    Ok(())
+}
