@@ -1,4 +1,4 @@
-//! How the laser tracker's JPDA defaults (and the moving-track option) were chosen: on the
+//! How the laser tracker's JPDA defaults (and the `max_leg_only_scans` option) were chosen: on the
 //! **synthetic** laser logs only (`datasets/segway_park`, `datasets/office_network`), the seed
 //! 002 leg model + `PeopleTracker` under each candidate setting, scored as the `laser_people`
 //! pipeline scores synthetic sessions (ground truth from `map` into the laser frame at the scan
@@ -134,6 +134,13 @@ fn main() -> Res<()> {
     let sessions: Vec<Vec<Scan>> = logs.iter().map(|l| load(l)).collect::<Res<_>>()?;
     let mut configs: Vec<(String, TrackerParams)> =
         vec![("gnn".into(), TrackerParams::default())];
+    for k in [3, 5, 10, 20] {
+        let p = TrackerParams {
+            max_leg_only_scans: Some(k),
+            ..TrackerParams::default()
+        };
+        configs.push((format!("gnn max_leg_only_scans={k}"), p));
+    }
     for pd in [0.6, 0.75, 0.9, 0.99] {
         for lambda in [0.005, 0.05, 0.5, 2.0] {
             let p = TrackerParams {

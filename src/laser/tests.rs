@@ -325,6 +325,41 @@ fn a_one_leg_occlusion_of_five_scans_keeps_the_track() {
     assert!(control[24].is_empty(), "{:?}", control[24]);
 }
 
+/// A person walks into view, then only one static leg-like object (radius 0.06 m, a pole)
+/// remains where they stopped: single-leg updates keep the track for ever unless
+/// `max_leg_only_scans` limits how long legs alone may carry it.
+#[test]
+fn a_static_single_leg_keeps_a_track_only_within_the_leg_only_limit() {
+    let synth = Synth::new();
+    let run = |limit: Option<usize>| {
+        let mut t = PeopleTracker::new(TrackerParams {
+            max_leg_only_scans: limit,
+            ..TrackerParams::default()
+        });
+        let mut alive = Vec::new();
+        for i in 0..60 {
+            let time = f64::from(i) * 0.1;
+            let centre = Point2::new(3.0, 0.0);
+            let circles = if i < 10 {
+                legs_of(centre, nalgebra::Vector2::new(1.0, 0.0)).to_vec()
+            } else {
+                vec![(centre + nalgebra::Vector2::new(0.0, 0.1), 0.06)]
+            };
+            let (people, single) = synth.detect(&circles);
+            assert_eq!((people.len(), single.len()), if i < 10 { (1, 0) } else { (0, 1) });
+            t.step(time, &people, &single);
+            alive.push(t.confirmed().count());
+        }
+        alive
+    };
+    assert!(run(None)[10..].iter().all(|&n| n == 1), "legs alone carry the track");
+    let limited = run(Some(5));
+    // pair updates on scans 0..9, legs on 10..14, misses from 15: the 10th miss (scan 24)
+    // deletes it
+    assert!(limited[2..24].iter().all(|&n| n == 1), "{limited:?}");
+    assert!(limited[24..].iter().all(|&n| n == 0), "{limited:?}");
+}
+
 fn jpda(pd: f64, lambda: f64) -> TrackerParams {
     TrackerParams {
         association: Association::Jpda(JpdaParams {
