@@ -187,10 +187,7 @@ pub fn clusters(
         }
     }
     let mut out: Vec<(usize, Vec<usize>, Vec<usize>)> = Vec::new();
-    for v in 0..tracks + meas {
-        if !in_gate[v] {
-            continue;
-        }
+    for (v, _) in in_gate.iter().enumerate().filter(|(_, g)| **g) {
         let root = find(&mut parent, v);
         let k = match out.iter().position(|c| c.0 == root) {
             Some(k) => k,
@@ -315,8 +312,8 @@ mod tests {
         let e: Vec<f64> = d2.iter().map(|d| (-0.5 * d).exp()).collect();
         let b = lambda * (2.0 * std::f64::consts::PI * det_s.sqrt()) * (1.0 - pd * pg) / pd;
         let sum = b + e.iter().sum::<f64>();
-        for j in 0..3 {
-            assert!(close(m.beta[0][j], e[j] / sum), "{m:?}");
+        for (j, ej) in e.iter().enumerate() {
+            assert!(close(m.beta[0][j], ej / sum), "{m:?}");
         }
         assert!(close(m.beta0[0], b / sum));
     }
