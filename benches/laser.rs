@@ -45,9 +45,12 @@ fn root() -> PathBuf {
 
 fn log_path(name: &str) -> Option<PathBuf> {
     let rel = format!("shared/real/laser/{name}/{name}.mcap");
-    [root().join("..").join(&rel), root().join("../..").join(&rel)]
-        .into_iter()
-        .find(|p| p.exists())
+    [
+        root().join("..").join(&rel),
+        root().join("../..").join(&rel),
+    ]
+    .into_iter()
+    .find(|p| p.exists())
 }
 
 fn decode(log: &SessionLog, topic: &str) -> Vec<LaserFrame> {
@@ -91,7 +94,10 @@ fn jpda() -> TrackerParams {
 fn run_all(frames: &[LaserFrame], params: TrackerParams) -> usize {
     let t0 = frames.first().map_or(0, |f| f.stamp.0);
     let mut tracker = PeopleTracker::new(params);
-    frames.iter().map(|f| detect_track(&mut tracker, f, t0)).sum()
+    frames
+        .iter()
+        .map(|f| detect_track(&mut tracker, f, t0))
+        .sum()
 }
 
 /// Scans per second of the sensor, from the first and last header stamps.
@@ -109,7 +115,11 @@ fn mean_ns(group: &str, id: &str) -> Option<f64> {
     let dir = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| root().join("target"));
-    let path = dir.join("criterion").join(group).join(id).join("new/estimates.json");
+    let path = dir
+        .join("criterion")
+        .join(group)
+        .join(id)
+        .join("new/estimates.json");
     let text = std::fs::read_to_string(path).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
     v["mean"]["point_estimate"].as_f64()

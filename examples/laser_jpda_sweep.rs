@@ -59,7 +59,13 @@ fn load(path: &str) -> Res<Vec<Scan>> {
         };
         let pts = points::project(&s.ranges, &g, Some(&pose));
         let segs = segment::segment(&pts, &SegmentOptions::default());
-        let d = legs::detect(&pts, &segs, s.ranges.len(), Some(&pose), &LegParams::default());
+        let d = legs::detect(
+            &pts,
+            &segs,
+            s.ranges.len(),
+            Some(&pose),
+            &LegParams::default(),
+        );
         let t0 = *t0.get_or_insert(f.stamp);
         let truth = gt
             .nearest(f.stamp, 50_000_000)
@@ -132,8 +138,7 @@ fn main() -> Res<()> {
         }
     }
     let sessions: Vec<Vec<Scan>> = logs.iter().map(|l| load(l)).collect::<Res<_>>()?;
-    let mut configs: Vec<(String, TrackerParams)> =
-        vec![("gnn".into(), TrackerParams::default())];
+    let mut configs: Vec<(String, TrackerParams)> = vec![("gnn".into(), TrackerParams::default())];
     for k in [3, 5, 10, 20] {
         let p = TrackerParams {
             max_leg_only_scans: Some(k),
@@ -154,7 +159,10 @@ fn main() -> Res<()> {
             configs.push((format!("jpda P_D={pd} λ={lambda}"), p));
         }
     }
-    println!("{:<28} {:>7} {:>7} {:>6} {:>6} {:>5}", "config", "MOTA", "IDF1", "FP", "FN", "IDSW");
+    println!(
+        "{:<28} {:>7} {:>7} {:>6} {:>6} {:>5}",
+        "config", "MOTA", "IDF1", "FP", "FN", "IDSW"
+    );
     for (name, p) in configs {
         let mut sum = [0.0; 6];
         for s in &sessions {

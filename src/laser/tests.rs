@@ -346,13 +346,19 @@ fn a_static_single_leg_keeps_a_track_only_within_the_leg_only_limit() {
                 vec![(centre + nalgebra::Vector2::new(0.0, 0.1), 0.06)]
             };
             let (people, single) = synth.detect(&circles);
-            assert_eq!((people.len(), single.len()), if i < 10 { (1, 0) } else { (0, 1) });
+            assert_eq!(
+                (people.len(), single.len()),
+                if i < 10 { (1, 0) } else { (0, 1) }
+            );
             t.step(time, &people, &single);
             alive.push(t.confirmed().count());
         }
         alive
     };
-    assert!(run(None)[10..].iter().all(|&n| n == 1), "legs alone carry the track");
+    assert!(
+        run(None)[10..].iter().all(|&n| n == 1),
+        "legs alone carry the track"
+    );
     let limited = run(Some(5));
     // pair updates on scans 0..9, legs on 10..14, misses from 15: the 10th miss (scan 24)
     // deletes it
