@@ -5,7 +5,7 @@ VENV := target/py-venv
 # py-motmetrics needs numpy 1, OpenCV 4.12 numpy 2: separate throwaway environments
 VENV_MOT := target/py-venv-mot
 
-.PHONY: help eval datasets release test bench interop clean opencv-agreement bench-gmm bench-multicam
+.PHONY: help eval datasets release test bench interop clean opencv-agreement bench-gmm bench-multicam bench-laser
 
 PROFILE ?= quick
 
@@ -20,6 +20,7 @@ help:
 	@echo "make bench-mlp         appearance-model training (10 splits) beside scikit-learn MLPRegressor, with the ratio"
 	@echo "make bench-gmm         adaptive GMM frames/s beside OpenCV MOG2 on the same frames, with ratios"
 	@echo "make bench-multicam    seed 004: frames/s of the whole s004_mohedano_multicam pipeline per camera and of the Gabor background alone"
+	@echo "make bench-laser       laser legs + tracker (GNN, JPDA) scans/s on the real logs, one thread, as a multiple of real time and of decoding"
 	@echo "make clean     remove build outputs and out/"
 
 release:
@@ -55,6 +56,11 @@ bench: $(VENV)/ok
 	$(MAKE) bench-gmm
 	$(MAKE) bench-mlp
 	$(MAKE) bench-multicam
+	$(MAKE) bench-laser
+
+# Laser people detection + tracking on the real logs in ../shared/real/laser (SKIPPED when absent).
+bench-laser:
+	$(CARGO) bench --bench laser -- --noplot
 
 # Seed 004: the whole s004_mohedano_multicam processing per camera frame and the Gabor stage alone
 # (a 2 s multicam_office session is synthesized into target/bench-data/ on first use).

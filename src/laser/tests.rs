@@ -8,7 +8,7 @@ use super::features::{self, RADIUS_CAP};
 use super::legs::{self, LegParams};
 use super::points::{self, ScanGeometry, ScanPoint};
 use super::segment::{self, SegmentOptions, Threshold};
-use super::tracker::{PeopleTracker, TrackerParams, Update};
+use super::tracker::{Association, JpdaParams, PeopleTracker, TrackerParams, Update};
 
 fn beams(segs: &[segment::Segment]) -> Vec<(usize, usize)> {
     segs.iter().map(|s| (s.first_beam, s.last_beam)).collect()
@@ -226,6 +226,18 @@ fn legs_of(centre: Point2<f64>, heading: nalgebra::Vector2<f64>) -> [(Point2<f64
 
 #[test]
 fn two_people_crossing_keep_their_ids() {
+    two_people_crossing(TrackerParams::default());
+}
+
+#[test]
+fn two_people_crossing_keep_their_ids_with_jpda() {
+    two_people_crossing(TrackerParams {
+        association: Association::Jpda(JpdaParams::default()),
+        ..TrackerParams::default()
+    });
+}
+
+fn two_people_crossing(params: TrackerParams) {
     let synth = Synth::new();
     let s = std::f64::consts::FRAC_1_SQRT_2;
     let (va, vb) = (nalgebra::Vector2::new(s, s), nalgebra::Vector2::new(s, -s));
@@ -233,7 +245,7 @@ fn two_people_crossing_keep_their_ids() {
     // 1 m/s on lines crossing at (4, 0); A there at t = 2 s, B at t = 2.4 s (closest 0.28 m)
     let a_at = |t: f64| cross + va * (t - 2.0);
     let b_at = |t: f64| cross + vb * (t - 2.4);
-    let mut tracker = PeopleTracker::new(TrackerParams::default());
+    let mut tracker = PeopleTracker::new(params);
     let (mut id_a, mut id_b) = (None, None);
     let mut closest = f64::INFINITY;
     for i in 0..60 {
@@ -311,6 +323,196 @@ fn a_one_leg_occlusion_of_five_scans_keeps_the_track() {
     // without the single-leg updates the track is lost during the occlusion
     let control = one_leg_occlusion(params, false);
     assert!(control[24].is_empty(), "{:?}", control[24]);
+}
+
+/// A person walks into view, then only one static leg-like object (radius 0.06 m, a pole)
+/// remains where they stopped: single-leg updates keep the track for ever unless
+/// `max_leg_only_scans` limits how long legs alone may carry it.
+#[test]
+fn a_static_single_leg_keeps_a_track_only_within_the_leg_only_limit() {
+    let synth = Synth::new();
+    let run = |limit: Option<usize>| {
+        let mut t = PeopleTracker::new(TrackerParams {
+            max_leg_only_scans: limit,
+            ..TrackerParams::default()
+        });
+        let mut alive = Vec::new();
+        for i in 0..60 {
+            let time = f64::from(i) * 0.1;
+            let centre = Point2::new(3.0, 0.0);
+            let circles = if i < 10 {
+                legs_of(centre, nalgebra::Vector2::new(1.0, 0.0)).to_vec()
+            } else {
+                vec![(centre + nalgebra::Vector2::new(0.0, 0.1), 0.06)]
+            };
+            let (people, single) = synth.detect(&circles);
+            assert_eq!(
+                (people.len(), single.len()),
+                if i < 10 { (1, 0) } else { (0, 1) }
+            );
+            t.step(time, &people, &single);
+            alive.push(t.confirmed().count());
+        }
+        alive
+    };
+    assert!(
+        run(None)[10..].iter().all(|&n| n == 1),
+        "legs alone carry the track"
+    );
+    let limited = run(Some(5));
+    // pair updates on scans 0..9, legs on 10..14, misses from 15: the 10th miss (scan 24)
+    // deletes it
+    assert!(limited[2..24].iter().all(|&n| n == 1), "{limited:?}");
+    assert!(limited[24..].iter().all(|&n| n == 0), "{limited:?}");
+}
+
+fn jpda(pd: f64, lambda: f64) -> TrackerParams {
+    TrackerParams {
+        association: Association::Jpda(JpdaParams {
+            detection_probability: pd,
+            clutter_density: lambda,
+            max_events: 1000,
+        }),
+        ..TrackerParams::default()
+    }
+}
+
+/// Two tracks started at (2, 0) and (2, 0.4), then at the same instant (dt = 0: no
+/// prediction, `P = diag(σp², σp², σv², σv²)`) two observations between them, all four pairs
+/// in the gate: one cluster of seven joint events. With `S = 2σp² I` the gain is ½ on position
+/// and 0 on velocity, so each track moves by ½ Σ_j β_tj ν_tj, β from the hand enumeration.
+#[test]
+fn jpda_two_tracks_two_observations_match_the_hand_enumeration() {
+    let (pd, lambda) = (0.8, 0.5);
+    let p = jpda(pd, lambda);
+    let mut t = PeopleTracker::new(p);
+    let x = [Point2::new(2.0, 0.0), Point2::new(2.0, 0.4)];
+    t.step(1.0, &x, &[]);
+    let z = [Point2::new(2.0, 0.15), Point2::new(2.05, 0.3)];
+    t.step(1.0, &z, &[]);
+    let s = 2.0 * p.person_sigma.powi(2);
+    let g = |a: &Point2<f64>, b: &Point2<f64>| {
+        let d2 = (a - b).norm_squared() / s;
+        assert!(d2 <= p.gate);
+        pd * (-0.5 * d2).exp() / (2.0 * std::f64::consts::PI * s)
+    };
+    let m = lambda * (1.0 - pd * (1.0 - (-0.5 * p.gate).exp()));
+    let w = |i: usize, j: usize| g(&x[i], &z[j]);
+    // (track 0's, track 1's observation), None = missed
+    let events = [
+        (None, None, m * m),
+        (Some(0), None, w(0, 0) * m),
+        (Some(1), None, w(0, 1) * m),
+        (None, Some(0), m * w(1, 0)),
+        (None, Some(1), m * w(1, 1)),
+        (Some(0), Some(1), w(0, 0) * w(1, 1)),
+        (Some(1), Some(0), w(0, 1) * w(1, 0)),
+    ];
+    let total: f64 = events.iter().map(|e| e.2).sum();
+    let beta = |track: usize, j: usize| {
+        events
+            .iter()
+            .filter(|e| [e.0, e.1][track] == Some(j))
+            .map(|e| e.2)
+            .sum::<f64>()
+            / total
+    };
+    assert_eq!(t.tracks().len(), 2, "both observations were taken");
+    for (i, tr) in t.tracks().iter().enumerate() {
+        let shift = (0..2).fold(nalgebra::Vector2::zeros(), |acc, j| {
+            acc + beta(i, j) * (z[j] - x[i])
+        });
+        let want = x[i] + 0.5 * shift;
+        assert!(
+            (tr.position() - want).norm() < 1e-12,
+            "track {i}: {tr:?} vs {want}"
+        );
+        assert!(tr.velocity().norm() < 1e-12);
+        assert_eq!(
+            tr.last,
+            Update::Person(i),
+            "the most probable event is 0→0, 1→1"
+        );
+    }
+}
+
+/// One track and two observations in its gate reduce to the PDAF weights
+/// `β_j = e_j / (b + Σ e)`, `b = λ |2πS|^{1/2} (1 − P_D P_G) / P_D`; the covariance carries
+/// the spread-of-innovations term. The observation outside the most probable event starts a
+/// new track.
+#[test]
+fn jpda_one_track_is_the_pdaf() {
+    let (pd, lambda) = (0.7, 2.0);
+    let p = jpda(pd, lambda);
+    let mut t = PeopleTracker::new(p);
+    let x0 = Point2::new(3.0, 1.0);
+    t.step(0.0, &[x0], &[]);
+    let z = [Point2::new(3.1, 1.0), Point2::new(2.9, 0.8)];
+    t.step(0.0, &z, &[]);
+    let (sp, sv) = (p.person_sigma.powi(2), p.init_velocity_sigma.powi(2));
+    let s = 2.0 * sp;
+    let e: Vec<f64> = z
+        .iter()
+        .map(|z| (-0.5 * (z - x0).norm_squared() / s).exp())
+        .collect();
+    let pg = 1.0 - (-0.5 * p.gate).exp();
+    let b = lambda * 2.0 * std::f64::consts::PI * s * (1.0 - pd * pg) / pd;
+    let sum = b + e[0] + e[1];
+    let beta = [e[0] / sum, e[1] / sum];
+    let nu: Vec<nalgebra::Vector2<f64>> = z.iter().map(|z| z - x0).collect();
+    let comb = beta[0] * nu[0] + beta[1] * nu[1];
+    let k = sp / s; // position gain, velocity gain 0
+    let tr = &t.tracks()[0];
+    assert!((tr.position() - (x0 + k * comb)).norm() < 1e-12, "{tr:?}");
+    // P⁺ = β0 P + (1 − β0) P_c + K (Σ β ν νᵀ − ν νᵀ) K
+    let beta0 = b / sum;
+    let spread = beta[0] * nu[0] * nu[0].transpose() + beta[1] * nu[1] * nu[1].transpose()
+        - comb * comb.transpose();
+    for (a, c) in [(0, 0), (0, 1), (1, 1)] {
+        let eye = if a == c { 1.0 } else { 0.0 };
+        let want =
+            beta0 * sp * eye + (1.0 - beta0) * (sp - k * k * s) * eye + k * k * spread[(a, c)];
+        assert!(
+            (tr.filter.p[(a, c)] - want).abs() < 1e-12,
+            "P[{a},{c}] {tr:?}"
+        );
+    }
+    assert!((tr.filter.p[(2, 2)] - sv).abs() < 1e-12);
+    assert_eq!(tr.last, Update::Person(0));
+    assert_eq!(t.tracks().len(), 2);
+    assert_eq!(t.tracks()[1].position(), z[1]);
+}
+
+/// With P_D = 1, no clutter and people far apart every cluster is one track and one
+/// observation with β = 1: JPDA is the Kalman update, scan for scan the GNN tracker's state.
+#[test]
+fn jpda_without_clutter_and_misses_is_the_kalman_filter() {
+    let synth = Synth::new();
+    let mut gnn = PeopleTracker::new(TrackerParams::default());
+    let mut jp = PeopleTracker::new(jpda(1.0, 0.0));
+    for i in 0..30 {
+        let t = f64::from(i) * 0.1;
+        let a = Point2::new(2.0 + 0.8 * t, 2.0);
+        let b = Point2::new(5.0, -2.0 + 0.5 * t);
+        let mut circles = legs_of(a, nalgebra::Vector2::new(1.0, 0.0)).to_vec();
+        circles.extend(legs_of(b, nalgebra::Vector2::new(1.0, 0.0)));
+        let (people, single) = synth.detect(&circles);
+        assert_eq!(people.len(), 2, "scan {i}");
+        gnn.step(t, &people, &single);
+        jp.step(t, &people, &single);
+        assert_eq!(gnn.tracks().len(), jp.tracks().len());
+        for (g, j) in gnn.tracks().iter().zip(jp.tracks()) {
+            assert_eq!(
+                (g.id, g.confirmed, g.last),
+                (j.id, j.confirmed, j.last),
+                "scan {i}"
+            );
+            assert!((g.filter.x - j.filter.x).norm() < 1e-9, "scan {i}");
+            assert!((g.filter.p - j.filter.p).norm() < 1e-9, "scan {i}");
+        }
+    }
+    assert_eq!(jp.confirmed().count(), 2);
+    assert_eq!(jp.jpda_fallbacks(), 0);
 }
 
 #[test]

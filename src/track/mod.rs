@@ -2,10 +2,13 @@
 //!
 //! - [`position`]: the position Kalman filter of seed 000 (x_k = x_{k−1} + u_k + w).
 //! - [`kalman`]: linear Kalman filter, constant-velocity and random-walk models.
+//! - [`jpda`]: joint probabilistic data association (gated clusters, exact joint events, the
+//!   PDAF combined-innovation update).
 //! - [`graph_match`]: 2-D tracking by graph matching of rectangles (seed 004 §4).
 //! - [`cylinders`]: multi-camera 3-D tracking of people as cylinders (seed 004 §5).
 
 pub mod cylinders;
 pub mod graph_match;
+pub mod jpda;
 pub mod kalman;
 pub mod position;

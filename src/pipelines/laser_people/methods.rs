@@ -4,6 +4,9 @@
 //!
 //! - **`legs`**: seed 002 leg model → leg pairs (people) and single legs in the fixed frame →
 //!   [`PeopleTracker`] (CV Kalman, GNN, M-of-N); its confirmed tracks after each scan.
+//! - **`legs_jpda`**: the same with JPDA association ([`Association::Jpda`] at its defaults).
+//! - **`legs_leg_limit`**: `legs` where single legs carry a track for at most
+//!   [`LEG_ONLY_SCANS`] scans after its last leg-pair update (`max_leg_only_scans`).
 //! - **`nearest`**: the baseline without a filter: the midpoint of the two legs nearest to the
 //!   laser (any distance apart), one hypothesis with id 1 on each scan with two legs or more.
 //!
@@ -17,13 +20,15 @@ use crate::frames::laser::LaserFrame;
 use crate::laser::legs::{self, Detections, LegParams};
 use crate::laser::points::{self, ScanGeometry, ScanPoint};
 use crate::laser::segment::{self, Segment, SegmentOptions};
-use crate::laser::tracker::{PeopleTracker, TrackerParams};
+use crate::laser::tracker::{Association, JpdaParams, LEG_ONLY_SCANS, PeopleTracker, TrackerParams};
 
 /// A detection + tracking method, by its name in the pipeline file and the tables.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
     Legs,
+    LegsJpda,
+    LegsLegLimit,
     Nearest,
 }
 
@@ -32,6 +37,8 @@ impl Method {
     pub fn name(self) -> &'static str {
         match self {
             Method::Legs => "legs",
+            Method::LegsJpda => "legs_jpda",
+            Method::LegsLegLimit => "legs_leg_limit",
             Method::Nearest => "nearest",
         }
     }
@@ -40,6 +47,8 @@ impl Method {
     pub fn describe(self) -> &'static str {
         match self {
             Method::Legs => "seed 002 leg model + PeopleTracker (CV Kalman, GNN, M-of-N; confirmed tracks)",
+            Method::LegsJpda => "seed 002 leg model + PeopleTracker with JPDA (P_D, clutter density at their synthetic-data defaults)",
+            Method::LegsLegLimit => "legs, single legs carry a track at most 20 scans after its last leg pair (chosen on synthetic data)",
             Method::Nearest => {
                 "midpoint of the two legs nearest to the laser, no filter, one id (the baseline)"
             }
@@ -103,6 +112,14 @@ impl Runner {
     pub fn new(method: Method) -> Runner {
         match method {
             Method::Legs => Runner::Tracked(Box::new(PeopleTracker::new(TrackerParams::default()))),
+            Method::LegsJpda => Runner::Tracked(Box::new(PeopleTracker::new(TrackerParams {
+                association: Association::Jpda(JpdaParams::default()),
+                ..TrackerParams::default()
+            }))),
+            Method::LegsLegLimit => Runner::Tracked(Box::new(PeopleTracker::new(TrackerParams {
+                max_leg_only_scans: Some(LEG_ONLY_SCANS),
+                ..TrackerParams::default()
+            }))),
             Method::Nearest => Runner::Nearest,
         }
     }
