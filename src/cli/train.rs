@@ -163,7 +163,10 @@ fn leg_detector(a: &LegArgs, out: &mut dyn std::io::Write) -> anyhow::Result<()>
         seed: a.seed,
         ..LearnedParams::default()
     };
-    anyhow::ensure!(a.folds >= 2 && a.trees >= 1, "--folds must be ≥ 2 and --trees ≥ 1");
+    anyhow::ensure!(
+        a.folds >= 2 && a.trees >= 1,
+        "--folds must be ≥ 2 and --trees ≥ 1"
+    );
     let source = match a.source {
         LegSource::Real => Source::Real,
         LegSource::Synthetic => Source::Synthetic,
@@ -175,26 +178,53 @@ fn leg_detector(a: &LegArgs, out: &mut dyn std::io::Write) -> anyhow::Result<()>
     let json = serde_json::to_vec(&*model)?;
     atomic::write_atomic(&a.out, &json, None)
         .with_context(|| format!("writing {}", a.out.display()))?;
-    let mut csv = String::from("source,fold,test_groups,test_legs,test_non_legs,precision,recall,f1,threshold\n");
+    let mut csv = String::from(
+        "source,fold,test_groups,test_legs,test_non_legs,precision,recall,f1,threshold\n",
+    );
     writeln!(
         out,
         "{} leg detector: {} legs, {} non-legs ({} labels without a segment), threshold {:.2}",
-        source.name(), model.positives, model.negatives, model.unmatched_labels, model.threshold
+        source.name(),
+        model.positives,
+        model.negatives,
+        model.unmatched_labels,
+        model.threshold
     )?;
-    writeln!(out, "  {:<8} {:>6} {:>8} {:>9} {:>7} {:>6}  test groups", "fold", "legs", "non-legs", "precision", "recall", "F1")?;
+    writeln!(
+        out,
+        "  {:<8} {:>6} {:>8} {:>9} {:>7} {:>6}  test groups",
+        "fold", "legs", "non-legs", "precision", "recall", "F1"
+    )?;
     for f in &model.cv {
         writeln!(
             out,
             "  {:<8} {:>6} {:>8} {:>9.3} {:>7.3} {:>6.3}  {}",
-            f.fold, f.positives, f.negatives, f.precision, f.recall, f.f1, f.groups.join(" ")
+            f.fold,
+            f.positives,
+            f.negatives,
+            f.precision,
+            f.recall,
+            f.f1,
+            f.groups.join(" ")
         )?;
         let _ = writeln!(
             csv,
             "{},{},{},{},{},{:.4},{:.4},{:.4},{:.2}",
-            source.name(), f.fold, f.groups.join(" "), f.positives, f.negatives, f.precision, f.recall, f.f1, model.threshold
+            source.name(),
+            f.fold,
+            f.groups.join(" "),
+            f.positives,
+            f.negatives,
+            f.precision,
+            f.recall,
+            f.f1,
+            model.threshold
         );
     }
-    let table = a.table.clone().unwrap_or_else(|| a.out.with_extension("cv.csv"));
+    let table = a
+        .table
+        .clone()
+        .unwrap_or_else(|| a.out.with_extension("cv.csv"));
     atomic::write_atomic(&table, csv.as_bytes(), None)
         .with_context(|| format!("writing {}", table.display()))?;
     writeln!(out, "  model  {}", a.out.display())?;

@@ -92,11 +92,17 @@ fn bad(file: &str, line: usize, why: impl Into<String>) -> TrainingError {
 fn data_lines(text: &str) -> impl Iterator<Item = (usize, Vec<&str>)> {
     text.lines().enumerate().filter_map(|(i, l)| {
         let l = l.trim();
-        (!l.is_empty() && !l.starts_with('#')).then(|| (i + 1, l.split(',').map(str::trim).collect()))
+        (!l.is_empty() && !l.starts_with('#'))
+            .then(|| (i + 1, l.split(',').map(str::trim).collect()))
     })
 }
 
-fn num<T: std::str::FromStr>(file: &str, line: usize, what: &str, s: &str) -> Result<T, TrainingError> {
+fn num<T: std::str::FromStr>(
+    file: &str,
+    line: usize,
+    what: &str,
+    s: &str,
+) -> Result<T, TrainingError> {
     s.parse()
         .map_err(|_| bad(file, line, format!("{what} {s:?} is not a number")))
 }
@@ -106,11 +112,19 @@ pub fn parse_scans(text: &str, file: &str) -> Result<Vec<ScanRecord>, TrainingEr
     data_lines(text)
         .map(|(line, f)| {
             if f.len() < 9 {
-                return Err(bad(file, line, format!("{} fields, expected at least 9", f.len())));
+                return Err(bad(
+                    file,
+                    line,
+                    format!("{} fields, expected at least 9", f.len()),
+                ));
             }
             let n: usize = num(file, line, "n", f[8])?;
             if f.len() != 9 + n {
-                return Err(bad(file, line, format!("n = {n} but {} ranges", f.len() - 9)));
+                return Err(bad(
+                    file,
+                    line,
+                    format!("n = {n} but {} ranges", f.len() - 9),
+                ));
             }
             let ranges = f[9..]
                 .iter()
@@ -171,7 +185,12 @@ pub fn centroid(points: &[ScanPoint], s: &Segment) -> Point2<f64> {
     if seg.is_empty() {
         return Point2::origin();
     }
-    Point2::from(seg.iter().map(|p| p.sensor.coords).sum::<nalgebra::Vector2<f64>>() / seg.len() as f64)
+    Point2::from(
+        seg.iter()
+            .map(|p| p.sensor.coords)
+            .sum::<nalgebra::Vector2<f64>>()
+            / seg.len() as f64,
+    )
 }
 
 /// The feature vector of segment `i` of a segmented scan.
@@ -220,7 +239,9 @@ pub fn positive_samples(
         }
         let s = segment_scan(&scan.ranges, &scan.geometry);
         let hit = match_labels(&s.centroids, &mine, LABEL_MATCH_M);
-        unmatched += mine.len().saturating_sub(hit.iter().filter(|&&h| h).count());
+        unmatched += mine
+            .len()
+            .saturating_sub(hit.iter().filter(|&&h| h).count());
         for (i, _) in hit.iter().enumerate().filter(|(_, h)| **h) {
             out.push(Sample {
                 group: group.to_string(),
@@ -322,7 +343,8 @@ mod tests {
 
     #[test]
     fn legs_csv_gives_exact_labels() {
-        let l = parse_legs("# scan_idx,x_m,y_m\n0,1.5,-0.25\n0,2,0.5\n3,0.5,0\n", "l").expect("parse");
+        let l =
+            parse_legs("# scan_idx,x_m,y_m\n0,1.5,-0.25\n0,2,0.5\n3,0.5,0\n", "l").expect("parse");
         assert_eq!(
             l,
             vec![
@@ -349,12 +371,21 @@ mod tests {
         let s = segment_scan(&ranges, &g);
         assert_eq!(s.segments.len(), 2);
         let obj = s.centroids[1];
-        let expect_x: f64 = (12..16).map(|k| (-0.08 + f64::from(k) * 0.01).cos()).sum::<f64>() / 4.0;
+        let expect_x: f64 = (12..16)
+            .map(|k| (-0.08 + f64::from(k) * 0.01).cos())
+            .sum::<f64>()
+            / 4.0;
         assert!((obj.x - expect_x).abs() < 1e-6, "{obj}");
         let label = obj + nalgebra::Vector2::new(0.05, 0.0);
-        assert_eq!(match_labels(&s.centroids, &[label], LABEL_MATCH_M), vec![false, true]);
+        assert_eq!(
+            match_labels(&s.centroids, &[label], LABEL_MATCH_M),
+            vec![false, true]
+        );
         let far = obj + nalgebra::Vector2::new(0.2, 0.0);
-        assert_eq!(match_labels(&s.centroids, &[far], LABEL_MATCH_M), vec![false, false]);
+        assert_eq!(
+            match_labels(&s.centroids, &[far], LABEL_MATCH_M),
+            vec![false, false]
+        );
         // one file's samples: the object is the positive, the wall is not used
         let scans = vec![ScanRecord {
             scan_idx: 7,
@@ -378,10 +409,10 @@ mod tests {
     #[test]
     fn synthetic_labels_leg_near_unknown_and_far_negative() {
         let c = [
-            Point2::new(2.0, 0.0),  // at a leg's surface (0.06 from its centre)
-            Point2::new(2.3, 0.0),  // 0.24 from the leg: neither
-            Point2::new(2.0, 2.0),  // clear
-            Point2::new(6.0, 0.0),  // clear but beyond 5 m
+            Point2::new(2.0, 0.0), // at a leg's surface (0.06 from its centre)
+            Point2::new(2.3, 0.0), // 0.24 from the leg: neither
+            Point2::new(2.0, 2.0), // clear
+            Point2::new(6.0, 0.0), // clear but beyond 5 m
         ];
         let legs = [(Point2::new(2.06, 0.0), 0.06)];
         assert_eq!(

@@ -17,10 +17,10 @@
 //! trees are private). So the forest here is a list of one-tree smartcore forests with seeds
 //! `seed, seed + 1, …` — each one a bootstrap sample and per-split feature draws, exactly one
 //! tree of a random forest — and the probability is their vote fraction. That bagging loop
-//! (a few lines) is the only hand-written part. Trees are fitted in parallel with rayon and
-//! collected in order: the same seed gives the same forest whatever the thread count.
+//! (a few lines) is the only hand-written part. Trees are fitted one after another: the same
+//! seed gives the same forest, and a caller may train while holding a lock inside a rayon job
+//! (a rayon join inside could run another job of the same thread that waits on that lock).
 
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use smartcore::ensemble::random_forest_classifier::{
     RandomForestClassifier, RandomForestClassifierParameters,
@@ -106,7 +106,6 @@ impl Forest {
         let m = matrix(x, features)?;
         let labels: Vec<i32> = y.iter().map(|&v| i32::from(v)).collect();
         let trees = (0..params.n_trees)
-            .into_par_iter()
             .map(|i| {
                 let p = RandomForestClassifierParameters::default()
                     .with_n_trees(1)
@@ -132,7 +131,9 @@ impl Forest {
         let m = matrix(x, self.features)?;
         let mut votes = vec![0u32; m.shape().0];
         for t in &self.trees {
-            let p = t.predict(&m).map_err(|e| ForestError::Crate(e.to_string()))?;
+            let p = t
+                .predict(&m)
+                .map_err(|e| ForestError::Crate(e.to_string()))?;
             for (v, c) in votes.iter_mut().zip(p) {
                 *v += u32::from(c == 1);
             }

@@ -8,9 +8,9 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use super::params::{Params, Sequence};
 use super::classifier;
 use super::methods::Method;
+use super::params::{Params, Sequence};
 use super::tables::{self, ScanRow, SessionRow, TrackRow, TruthRow};
 use crate::eval::mot::{EventKind, Geometry, GroundPoint, MatchRule, Observation, evaluate};
 use crate::eval::stats::paired_t;

@@ -14,9 +14,9 @@ use super::learned::{self, LegModel, Source, Unavailable};
 use super::methods::Method;
 use super::params::Params;
 use crate::laser::training::{Sample, sample_feature_names};
+use crate::report::Table;
 use crate::report::figure::{Figure, FigureKind, LinePlot, Series};
 use crate::report::rows::Rows;
-use crate::report::Table;
 use crate::run::Products;
 use crate::table_row;
 
@@ -80,23 +80,23 @@ fn rows(source: Source, m: &Result<Arc<LegModel>, Unavailable>) -> Vec<Classifie
     match m {
         Err(Unavailable::Absent(why)) => vec![blank(format!("SKIPPED: {why}"))],
         Err(Unavailable::Failed(why)) => vec![blank(format!("FAILED: {why}"))],
-        Ok(m) => m
-            .cv
-            .iter()
-            .map(|f| ClassifierRow {
-                test_groups: f.groups.join(" "),
-                test_legs: f.positives as i64,
-                test_non_legs: f.negatives as i64,
-                precision: finite(f.precision),
-                recall: finite(f.recall),
-                f1: finite(f.f1),
-                threshold: Some(m.threshold),
-                training_legs: m.positives as i64,
-                training_non_legs: m.negatives as i64,
-                unmatched_labels: m.unmatched_labels as i64,
-                ..blank(f.fold.clone())
-            })
-            .collect(),
+        Ok(m) => {
+            m.cv.iter()
+                .map(|f| ClassifierRow {
+                    test_groups: f.groups.join(" "),
+                    test_legs: f.positives as i64,
+                    test_non_legs: f.negatives as i64,
+                    precision: finite(f.precision),
+                    recall: finite(f.recall),
+                    f1: finite(f.f1),
+                    threshold: Some(m.threshold),
+                    training_legs: m.positives as i64,
+                    training_non_legs: m.negatives as i64,
+                    unmatched_labels: m.unmatched_labels as i64,
+                    ..blank(f.fold.clone())
+                })
+                .collect()
+        }
     }
 }
 
@@ -119,8 +119,18 @@ fn matched(real: &[Sample], syn: &[Sample], k: usize) -> (Vec<(f64, f64)>, Vec<(
     };
     let (cr, cs) = (count(real), count(syn));
     let both: Vec<bool> = cr.iter().zip(&cs).map(|(a, b)| *a > 0 && *b > 0).collect();
-    let nr: usize = cr.iter().zip(&both).filter(|(_, b)| **b).map(|(c, _)| c).sum();
-    let ns: usize = cs.iter().zip(&both).filter(|(_, b)| **b).map(|(c, _)| c).sum();
+    let nr: usize = cr
+        .iter()
+        .zip(&both)
+        .filter(|(_, b)| **b)
+        .map(|(c, _)| c)
+        .sum();
+    let ns: usize = cs
+        .iter()
+        .zip(&both)
+        .filter(|(_, b)| **b)
+        .map(|(c, _)| c)
+        .sum();
     let pick = |s: &[Sample], w: &dyn Fn(usize) -> f64| -> Vec<(f64, f64)> {
         s.iter()
             .filter(|x| x.leg)
@@ -143,8 +153,16 @@ fn histogram(v: &[(f64, f64)], edges: &[f64]) -> Vec<(f64, f64)> {
     let width = edges[1] - edges[0];
     let mut out = Vec::new();
     for w in edges.windows(2) {
-        let mass: f64 = v.iter().filter(|x| x.0 >= w[0] && x.0 < w[1]).map(|x| x.1).sum();
-        let d = if total > 0.0 { mass / total / width } else { 0.0 };
+        let mass: f64 = v
+            .iter()
+            .filter(|x| x.0 >= w[0] && x.0 < w[1])
+            .map(|x| x.1)
+            .sum();
+        let d = if total > 0.0 {
+            mass / total / width
+        } else {
+            0.0
+        };
         out.push((w[0], d));
         out.push((w[1], d));
     }
@@ -153,7 +171,9 @@ fn histogram(v: &[(f64, f64)], edges: &[f64]) -> Vec<(f64, f64)> {
 
 fn quantile(mut v: Vec<f64>, q: f64) -> f64 {
     v.sort_by(f64::total_cmp);
-    v.get(((v.len() as f64 - 1.0) * q).round() as usize).copied().unwrap_or(0.0)
+    v.get(((v.len() as f64 - 1.0) * q).round() as usize)
+        .copied()
+        .unwrap_or(0.0)
 }
 
 fn figures(real: &[Sample], syn: &[Sample]) -> Vec<Figure> {
@@ -169,16 +189,29 @@ fn figures(real: &[Sample], syn: &[Sample]) -> Vec<Figure> {
             let all: Vec<f64> = r.iter().chain(&s).map(|x| x.0).collect();
             let (lo, hi) = (quantile(all.clone(), 0.0), quantile(all, 0.98));
             let hi = if hi > lo { hi } else { lo + 1.0 };
-            let edges: Vec<f64> = (0..=30).map(|i| lo + (hi - lo) * f64::from(i) / 30.0).collect();
+            let edges: Vec<f64> = (0..=30)
+                .map(|i| lo + (hi - lo) * f64::from(i) / 30.0)
+                .collect();
             Some(Figure::new(
                 format!("leg_features_{f}"),
-                format!("Leg clusters, {f}: real vs synthetic at equal range ({}–{} m)", RANGE_BINS_M.0, RANGE_BINS_M.1),
+                format!(
+                    "Leg clusters, {f}: real vs synthetic at equal range ({}–{} m)",
+                    RANGE_BINS_M.0, RANGE_BINS_M.1
+                ),
                 FigureKind::Lines(LinePlot {
                     x_label: (*f).to_string(),
                     y_label: "density".into(),
                     series: vec![
-                        Series::line(format!("real (leg_tracker labels, n = {})", r.len()), histogram(&r, &edges), 0),
-                        Series::line(format!("synthetic (range-weighted, n = {})", s.len()), histogram(&s, &edges), 1),
+                        Series::line(
+                            format!("real (leg_tracker labels, n = {})", r.len()),
+                            histogram(&r, &edges),
+                            0,
+                        ),
+                        Series::line(
+                            format!("synthetic (range-weighted, n = {})", s.len()),
+                            histogram(&s, &edges),
+                            1,
+                        ),
                     ],
                     x_range: Some((lo, hi)),
                     ..LinePlot::default()
@@ -236,7 +269,13 @@ mod tests {
     /// 1.0–1.5 m and 3 in 2.0–2.5 m; synthetic 2 and 2; a bin only one side has is dropped.
     #[test]
     fn synthetic_weights_follow_the_real_range_distribution() {
-        let real = vec![leg(1.2, 1.0), leg(2.1, 2.0), leg(2.2, 2.0), leg(2.3, 2.0), leg(3.3, 9.0)];
+        let real = vec![
+            leg(1.2, 1.0),
+            leg(2.1, 2.0),
+            leg(2.2, 2.0),
+            leg(2.3, 2.0),
+            leg(3.3, 9.0),
+        ];
         let syn = vec![leg(1.1, 5.0), leg(1.4, 5.0), leg(2.0, 6.0), leg(2.4, 6.0)];
         let (r, s) = matched(&real, &syn, 0);
         assert_eq!(r.len(), 4);
@@ -245,6 +284,14 @@ mod tests {
         assert_eq!(w, vec![(5.0, 0.5), (5.0, 0.5), (6.0, 1.5), (6.0, 1.5)]);
         let h = histogram(&r, &[0.0, 1.5, 3.0]);
         // real values 1, 2, 2, 2: a quarter of the mass in [0, 1.5), three quarters in [1.5, 3)
-        assert_eq!(h, vec![(0.0, 0.25 / 1.5), (1.5, 0.25 / 1.5), (1.5, 0.75 / 1.5), (3.0, 0.75 / 1.5)]);
+        assert_eq!(
+            h,
+            vec![
+                (0.0, 0.25 / 1.5),
+                (1.5, 0.25 / 1.5),
+                (1.5, 0.75 / 1.5),
+                (3.0, 0.75 / 1.5)
+            ]
+        );
     }
 }

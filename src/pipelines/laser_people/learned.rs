@@ -35,13 +35,56 @@ use anyhow::Context;
 use nalgebra::{Point2, Point3};
 use serde::{Deserialize, Serialize};
 
-use super::params::LearnedParams;
 use crate::frames::laser::{self as laser_frames, LaserOptions};
 use crate::frames::truth;
 use crate::laser::points::ScanGeometry;
 use crate::laser::training::{self, Sample};
 use crate::learn::forest::{Forest, ForestParams};
 use crate::log::SessionLog;
+
+/// `[params.learned]`: where the learned leg detectors' training data is and how they are
+/// trained (see the module doc).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LearnedParams {
+    /// The leg_tracker training CSVs (`positive_K_{scans,legs}.csv`, `negative_K_scans.csv`).
+    pub training_dir: String,
+    /// Real negatives: every n-th segment of the people-free scans (leg_tracker: 1 in 50).
+    pub negative_keep_every: usize,
+    /// Synthetic training logs (globs).
+    pub synthetic_sessions: Vec<String>,
+    /// Synthetic: every n-th scan of a log (neighbouring scans are near copies).
+    pub synthetic_scan_every: usize,
+    /// Synthetic negatives: every n-th non-leg segment (1: all; the synthetic scenes have
+    /// few segments within 5 m besides the legs: about as many as legs).
+    pub synthetic_negative_keep_every: usize,
+    /// Synthetic samples farther than this from the laser are not used (m; the real labels
+    /// lie within 5 m).
+    pub max_range_m: f64,
+    /// Cross-validation folds (grouped by file).
+    pub folds: usize,
+    pub n_trees: u16,
+    pub seed: u64,
+}
+
+impl Default for LearnedParams {
+    fn default() -> Self {
+        LearnedParams {
+            training_dir: "../shared/real/laser/leg_training".into(),
+            negative_keep_every: 50,
+            synthetic_sessions: vec![
+                "datasets/segway_park/*.mcap".into(),
+                "datasets/office_network/*.mcap".into(),
+            ],
+            synthetic_scan_every: 2,
+            synthetic_negative_keep_every: 1,
+            max_range_m: 5.0,
+            folds: 3,
+            n_trees: 100,
+            seed: 1,
+        }
+    }
+}
 
 /// Which training data.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
@@ -140,7 +183,11 @@ pub fn real_samples(dir: &Path, keep_every: usize) -> anyhow::Result<TrainingSet
 }
 
 /// The synthetic training set: every `scan_every`-th scan of each session matching `globs`.
-pub fn synthetic_samples(p: &LearnedParams, scan_topic: &str, gt_topic: &str) -> anyhow::Result<TrainingSet> {
+pub fn synthetic_samples(
+    p: &LearnedParams,
+    scan_topic: &str,
+    gt_topic: &str,
+) -> anyhow::Result<TrainingSet> {
     let mut paths: Vec<PathBuf> = Vec::new();
     for g in &p.synthetic_sessions {
         for e in glob::glob(g).with_context(|| format!("bad glob {g}"))? {
@@ -223,7 +270,11 @@ pub fn assign_folds(samples: &[Sample], folds: usize) -> BTreeMap<String, usize>
         *groups.entry(&s.group).or_insert(false) |= s.leg;
     }
     for (g, pos) in groups {
-        if pos { with_pos.push(g) } else { neg_only.push(g) }
+        if pos {
+            with_pos.push(g)
+        } else {
+            neg_only.push(g)
+        }
     }
     let k = folds.max(1);
     let mut out = BTreeMap::new();
@@ -246,7 +297,13 @@ fn score(fold: String, groups: Vec<String>, p: &[f64], y: &[bool], threshold: f6
             _ => {}
         }
     }
-    let ratio = |a: usize, b: usize| if a + b == 0 { f64::NAN } else { a as f64 / (a + b) as f64 };
+    let ratio = |a: usize, b: usize| {
+        if a + b == 0 {
+            f64::NAN
+        } else {
+            a as f64 / (a + b) as f64
+        }
+    };
     let (precision, recall) = (ratio(tp, fp), ratio(tp, fnn));
     FoldScore {
         fold,
@@ -290,24 +347,45 @@ pub fn train(source: Source, set: TrainingSet, p: &LearnedParams) -> anyhow::Res
     let threshold = (1..20)
         .map(|i| f64::from(i) * 0.05)
         .map(|t| (t, score(String::new(), vec![], &oof, &y, t).f1))
-        .fold((0.5, f64::NEG_INFINITY), |best, (t, f)| if f > best.1 { (t, f) } else { best })
+        .fold((0.5, f64::NEG_INFINITY), |best, (t, f)| {
+            if f > best.1 { (t, f) } else { best }
+        })
         .0;
     let mut cv = Vec::new();
     for fold in 0..k {
         let idx: Vec<usize> = (0..samples.len())
             .filter(|&i| folds[&samples[i].group] == fold)
             .collect();
-        let groups = folds.iter().filter(|(_, f)| **f == fold).map(|(g, _)| g.clone()).collect();
+        let groups = folds
+            .iter()
+            .filter(|(_, f)| **f == fold)
+            .map(|(g, _)| g.clone())
+            .collect();
         let pf: Vec<f64> = idx.iter().map(|&i| oof[i]).collect();
         let yf: Vec<bool> = idx.iter().map(|&i| y[i]).collect();
-        cv.push(score(format!("fold {}", fold + 1), groups, &pf, &yf, threshold));
+        cv.push(score(
+            format!("fold {}", fold + 1),
+            groups,
+            &pf,
+            &yf,
+            threshold,
+        ));
     }
-    cv.push(score("pooled".into(), folds.keys().cloned().collect(), &oof, &y, threshold));
+    cv.push(score(
+        "pooled".into(),
+        folds.keys().cloned().collect(),
+        &oof,
+        &y,
+        threshold,
+    ));
     let (x, _): (Vec<Vec<f64>>, Vec<()>) = samples.iter().map(|s| (s.features.clone(), ())).unzip();
     let forest = Forest::fit(&x, &y, forest_params)?;
     Ok(LegModel {
         source,
-        features: training::sample_feature_names().iter().map(|s| s.to_string()).collect(),
+        features: training::sample_feature_names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
         threshold,
         positives: y.iter().filter(|&&v| v).count(),
         negatives: y.iter().filter(|&&v| !v).count(),
@@ -333,13 +411,20 @@ static MODELS: Mutex<BTreeMap<String, Cached>> = Mutex::new(BTreeMap::new());
 /// The training data of `source` is absent (the reason), or present (`None`).
 pub fn absent(source: Source, p: &LearnedParams) -> Option<String> {
     match source {
-        Source::Real => (!Path::new(&p.training_dir).is_dir())
-            .then(|| format!("{} absent", p.training_dir)),
+        Source::Real => {
+            (!Path::new(&p.training_dir).is_dir()).then(|| format!("{} absent", p.training_dir))
+        }
         Source::Synthetic => {
-            let any = p.synthetic_sessions.iter().any(|g| {
-                glob::glob(g).is_ok_and(|mut it| it.any(|e| e.is_ok()))
-            });
-            (!any).then(|| format!("no synthetic training logs ({})", p.synthetic_sessions.join(", ")))
+            let any = p
+                .synthetic_sessions
+                .iter()
+                .any(|g| glob::glob(g).is_ok_and(|mut it| it.any(|e| e.is_ok())));
+            (!any).then(|| {
+                format!(
+                    "no synthetic training logs ({})",
+                    p.synthetic_sessions.join(", ")
+                )
+            })
         }
     }
 }
@@ -365,7 +450,9 @@ pub fn model(source: Source, p: &LearnedParams, scan_topic: &str, gt_topic: &str
         source.name(),
         serde_json::to_string(p).unwrap_or_default()
     );
-    let mut cache = MODELS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let mut cache = MODELS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     cache
         .entry(key)
         .or_insert_with(|| train_source(source, p, scan_topic, gt_topic))

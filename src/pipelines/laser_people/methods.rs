@@ -21,8 +21,7 @@ use std::sync::Arc;
 use nalgebra::Point2;
 use serde::{Deserialize, Serialize};
 
-use super::learned::{self, LegModel, Source, Unavailable};
-use super::params::Params;
+use super::learned::{self, LearnedParams, LegModel, Source, Unavailable};
 use crate::laser::features;
 use crate::laser::legs::Leg;
 use crate::laser::points::to_fixed;
@@ -58,12 +57,18 @@ impl Method {
     /// One sentence for the results table's note.
     pub fn describe(self) -> &'static str {
         match self {
-            Method::Legs => "seed 002 leg model + PeopleTracker (CV Kalman, GNN, M-of-N; confirmed tracks)",
+            Method::Legs => {
+                "seed 002 leg model + PeopleTracker (CV Kalman, GNN, M-of-N; confirmed tracks)"
+            }
             Method::Nearest => {
                 "midpoint of the two legs nearest to the laser, no filter, one id (the baseline)"
             }
-            Method::Learned => "random-forest leg classifier trained on the real leg_tracker CSVs, seed 002 pairing + PeopleTracker",
-            Method::LearnedSynthetic => "the same classifier trained on the synthetic datasets only (in-sample on the synthetic sequences), seed 002 pairing + PeopleTracker",
+            Method::Learned => {
+                "random-forest leg classifier trained on the real leg_tracker CSVs, seed 002 pairing + PeopleTracker"
+            }
+            Method::LearnedSynthetic => {
+                "the same classifier trained on the synthetic datasets only (in-sample on the synthetic sequences), seed 002 pairing + PeopleTracker"
+            }
         }
     }
 
@@ -136,17 +141,25 @@ pub enum Runner {
 impl Runner {
     /// The method's runner; `None` when a learned method's training data is absent (its rows
     /// say SKIPPED); an error when its training failed.
-    pub fn new(method: Method, p: &Params) -> anyhow::Result<Option<Runner>> {
+    /// `scan_topic` and `gt_topic` are those of the synthetic training logs.
+    pub fn new(
+        method: Method,
+        p: &LearnedParams,
+        scan_topic: &str,
+        gt_topic: &str,
+    ) -> anyhow::Result<Option<Runner>> {
         let tracker = || Box::new(PeopleTracker::new(TrackerParams::default()));
         Ok(Some(match method {
             Method::Legs => Runner::Tracked(tracker()),
             Method::Nearest => Runner::Nearest,
             Method::Learned | Method::LearnedSynthetic => {
                 let source = method.source().unwrap_or(Source::Real);
-                match learned::model(source, &p.learned, &p.synthetic.scan_topic, &p.synthetic.gt_topic) {
+                match learned::model(source, p, scan_topic, gt_topic) {
                     Ok(m) => Runner::Learned(m, tracker()),
                     Err(Unavailable::Absent(_)) => return Ok(None),
-                    Err(Unavailable::Failed(e)) => anyhow::bail!("training the {} leg detector: {e}", method.name()),
+                    Err(Unavailable::Failed(e)) => {
+                        anyhow::bail!("training the {} leg detector: {e}", method.name())
+                    }
                 }
             }
         }))
@@ -179,9 +192,15 @@ fn learned_legs(model: &LegModel, view: &ScanView) -> Detections {
     let s = Segmented {
         points: view.points.clone(),
         segments: view.segments.clone(),
-        centroids: view.segments.iter().map(|g| centroid(&view.points, g)).collect(),
+        centroids: view
+            .segments
+            .iter()
+            .map(|g| centroid(&view.points, g))
+            .collect(),
     };
-    let x: Vec<Vec<f64>> = (0..s.segments.len()).map(|i| sample_features(&s, i)).collect();
+    let x: Vec<Vec<f64>> = (0..s.segments.len())
+        .map(|i| sample_features(&s, i))
+        .collect();
     let prob = model.probability(&x).unwrap_or_default();
     let pose = view.frame.pose.as_ref();
     let legs: Vec<Leg> = prob
@@ -192,7 +211,10 @@ fn learned_legs(model: &LegModel, view: &ScanView) -> Detections {
             let features = features::compute(&s.points, &s.segments[i]);
             let c = s.centroids[i];
             let (sensor, radius) = match features.circle {
-                Some(k) if k.radius <= LEARNED_MAX_RADIUS_M && k.centre.coords.norm() > c.coords.norm() => {
+                Some(k)
+                    if k.radius <= LEARNED_MAX_RADIUS_M
+                        && k.centre.coords.norm() > c.coords.norm() =>
+                {
                     (k.centre, k.radius)
                 }
                 _ => (c, 0.0),

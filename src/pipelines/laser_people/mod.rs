@@ -26,7 +26,8 @@ use crate::progress::Progress;
 use crate::run::config::Invalid;
 use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
 
-pub use params::{LearnedParams, Params, Sequence};
+pub use learned::LearnedParams;
+pub use params::{Params, Sequence};
 
 pub struct LaserPeople;
 

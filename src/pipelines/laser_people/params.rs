@@ -4,6 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::learned::LearnedParams;
 use super::methods::Method;
 use crate::groundtruth::PEOPLE_TOPIC;
 use crate::run::config::Invalid;
@@ -52,50 +53,6 @@ pub struct Params {
     pub methods: Vec<Method>,
     /// Training of the learned leg detectors (`learned`, `learned_synthetic`).
     pub learned: LearnedParams,
-}
-
-/// `[params.learned]`: where the learned leg detectors' training data is and how they are
-/// trained (see [`super::learned`]).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct LearnedParams {
-    /// The leg_tracker training CSVs (`positive_K_{scans,legs}.csv`, `negative_K_scans.csv`).
-    pub training_dir: String,
-    /// Real negatives: every n-th segment of the people-free scans (leg_tracker: 1 in 50).
-    pub negative_keep_every: usize,
-    /// Synthetic training logs (globs).
-    pub synthetic_sessions: Vec<String>,
-    /// Synthetic: every n-th scan of a log (neighbouring scans are near copies).
-    pub synthetic_scan_every: usize,
-    /// Synthetic negatives: every n-th non-leg segment (1: all; the synthetic scenes have
-    /// few segments within 5 m besides the legs: about as many as legs).
-    pub synthetic_negative_keep_every: usize,
-    /// Synthetic samples farther than this from the laser are not used (m; the real labels
-    /// lie within 5 m).
-    pub max_range_m: f64,
-    /// Cross-validation folds (grouped by file).
-    pub folds: usize,
-    pub n_trees: u16,
-    pub seed: u64,
-}
-
-impl Default for LearnedParams {
-    fn default() -> Self {
-        LearnedParams {
-            training_dir: "../shared/real/laser/leg_training".into(),
-            negative_keep_every: 50,
-            synthetic_sessions: vec![
-                "datasets/segway_park/*.mcap".into(),
-                "datasets/office_network/*.mcap".into(),
-            ],
-            synthetic_scan_every: 2,
-            synthetic_negative_keep_every: 1,
-            max_range_m: 5.0,
-            folds: 3,
-            n_trees: 100,
-            seed: 1,
-        }
-    }
 }
 
 impl Default for Params {
@@ -209,14 +166,22 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
     }
     check_sequence("synthetic", &p.synthetic, &mut out);
     let l = &p.learned;
-    if l.folds < 2 || l.n_trees == 0 || l.negative_keep_every == 0 || l.synthetic_scan_every == 0 || l.synthetic_negative_keep_every == 0 {
+    if l.folds < 2
+        || l.n_trees == 0
+        || l.negative_keep_every == 0
+        || l.synthetic_scan_every == 0
+        || l.synthetic_negative_keep_every == 0
+    {
         out.push((
             "learned".into(),
             "folds ≥ 2 and n_trees, negative_keep_every, synthetic_scan_every, synthetic_negative_keep_every ≥ 1".into(),
         ));
     }
     if !(l.max_range_m.is_finite() && l.max_range_m > 0.0) {
-        out.push(("learned".into(), format!("max_range_m {} must be finite and > 0", l.max_range_m)));
+        out.push((
+            "learned".into(),
+            format!("max_range_m {} must be finite and > 0", l.max_range_m),
+        ));
     }
     if p.methods.is_empty() {
         out.push(("methods".into(), "needs at least one method".into()));

@@ -200,7 +200,12 @@ pub(super) fn process(
     bar.set_length(expected.unwrap_or(0));
     let mut runners: Vec<(Method, Runner)> = Vec::new();
     for &m in &p.methods {
-        if let Some(r) = Runner::new(m, p)? {
+        if let Some(r) = Runner::new(
+            m,
+            &p.learned,
+            &p.synthetic.scan_topic,
+            &p.synthetic.gt_topic,
+        )? {
             runners.push((m, r));
         }
     }
