@@ -53,8 +53,8 @@ pub enum Model {
     /// and F1 of k-fold cross-validation grouped by file, so that scans of one recording never
     /// sit on both sides; the probability threshold is the one with the best out-of-fold F1.
     /// The final model (all samples) is saved as JSON with its threshold and CV scores. The
-    /// same seed gives the same model. The pipeline trains the same model itself: this
-    /// command is for inspecting it or training on your own data.
+    /// same seed gives the same model. The pipeline trains the same model itself (it does not
+    /// load model files): this command shows and saves it, e.g. to train on your own CSVs.
     ///
     /// Example: peopletrack train leg-detector --out models/legs.json
     LegDetector(LegArgs),

@@ -263,7 +263,7 @@ pub fn negative_samples(group: &str, scans: &[ScanRecord], keep_every: usize) ->
     for scan in scans {
         let s = segment_scan(&scan.ranges, &scan.geometry);
         for i in 0..s.segments.len() {
-            if k % keep_every.max(1) == 0 {
+            if k.is_multiple_of(keep_every.max(1)) {
                 out.push(Sample {
                     group: format!("{group}/{}", scan.frame_id),
                     scan_idx: scan.scan_idx,

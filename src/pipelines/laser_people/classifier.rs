@@ -105,8 +105,11 @@ fn bin(range_m: f64) -> Option<usize> {
     (range_m >= lo && range_m < hi).then(|| ((range_m - lo) / 0.5) as usize)
 }
 
+/// `(value, weight)` pairs.
+type Weighted = Vec<(f64, f64)>;
+
 /// `(value, weight)` of feature `k` of the real and the synthetic legs, at equal range.
-fn matched(real: &[Sample], syn: &[Sample], k: usize) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+fn matched(real: &[Sample], syn: &[Sample], k: usize) -> (Weighted, Weighted) {
     let nbins = bin(RANGE_BINS_M.1 - 1e-9).unwrap_or(0) + 1;
     let count = |s: &[Sample]| {
         let mut c = vec![0usize; nbins];

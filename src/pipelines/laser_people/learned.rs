@@ -241,7 +241,7 @@ pub fn synthetic_samples(
                 let Some(leg) = *l else { continue };
                 if !leg {
                     negatives += 1;
-                    if (negatives - 1) % p.synthetic_negative_keep_every.max(1) != 0 {
+                    if !(negatives - 1).is_multiple_of(p.synthetic_negative_keep_every.max(1)) {
                         continue;
                     }
                 }
