@@ -296,6 +296,57 @@ fn two_walkers_are_tracked_exactly() {
     assert!(out.join("laser_people/tables/paired_ttest.csv").exists());
 }
 
+/// The learned detectors without their training data (`../shared/real` absent, no synthetic
+/// logs): their rows say SKIPPED with the reason, the other methods are scored as before, and
+/// the `leg_classifier` table has one SKIPPED row per source.
+#[test]
+fn learned_methods_without_training_data_are_skipped() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = dir.path().join("walkers");
+    std::fs::create_dir_all(&data).expect("mkdir");
+    write_log(&data.join("walkers_00.mcap"), false);
+    let toml = dir.path().join("laser_people.toml");
+    let absent = dir.path().join("no_training");
+    let learned = format!(
+        "methods = [\"legs\", \"learned\", \"learned_synthetic\"]\n\n[params.learned]\ntraining_dir = \"{}\"\nsynthetic_sessions = [\"{}/*.mcap\"]\n",
+        absent.display(),
+        absent.display()
+    );
+    let text = PIPELINE
+        .replace(
+            "[[params.sequences]]",
+            &format!("{learned}\n[[params.sequences]]"),
+        )
+        .replace(
+            "[inputs]\nsessions = []\n",
+            "[inputs]\nsessions = []\n\n[params]\n",
+        );
+    std::fs::write(&toml, text).expect("write pipeline");
+    let out = dir.path().join("out");
+    let sessions = vec![format!("{}/*.mcap", data.display())];
+    let summary = run_file(&toml, &options(&out, sessions)).expect("runs");
+    assert!(summary.skipped.is_empty(), "{:?}", summary.skipped);
+    let rows = csv_rows(&out.join("laser_people/tables/results.csv"));
+    assert_eq!(
+        row(&rows, "walkers_00", "legs")["mota"]
+            .parse::<f64>()
+            .expect("mota"),
+        1.0
+    );
+    for m in ["learned", "learned_synthetic"] {
+        let r = row(&rows, "walkers_00", m);
+        assert!(r["status"].starts_with("SKIPPED: "), "{r:?}");
+        assert!(r["mota"].is_empty(), "{r:?}");
+    }
+    assert!(row(&rows, "walkers_00", "learned")["status"].contains("no_training absent"));
+    let cls = csv_rows(&out.join("laser_people/tables/leg_classifier.csv"));
+    assert_eq!(cls.len(), 2, "{cls:?}");
+    assert!(
+        cls.iter().all(|r| r["fold"].starts_with("SKIPPED: ")),
+        "{cls:?}"
+    );
+}
+
 /// The real logs' ground-truth path on the same walkers: `leg_tracker/msg/Person` messages in
 /// the laser frame, each logged after its scan, a listed sequence with a scored-scan window, no
 /// TF (tracked in the laser frame): the same exact scores.

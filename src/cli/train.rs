@@ -1,5 +1,8 @@
 //! `peopletrack train omni-appearance --sessions GLOB`: learn an appearance model from your own
 //! logs and save it (network, feature normalisation, provenance) for `peopletrack run` to load.
+//! `peopletrack train leg-detector --out FILE`: the random-forest laser leg detector of
+//! `pipelines::laser_people::learned` (real leg_tracker CSVs or synthetic logs), with its
+//! grouped cross-validation printed and written as CSV.
 //!
 //! Training is the s000_cielniak_omni pipeline run on the given sessions: the webcam measurement system is
 //! calibrated on the calibration segment and provides the distances the network learns, and
@@ -10,7 +13,10 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
+use peopletrack::groundtruth::PEOPLE_TOPIC;
 use peopletrack::pipelines;
+use peopletrack::pipelines::laser_people::LearnedParams;
+use peopletrack::pipelines::laser_people::learned::{self, Source, Unavailable};
 use peopletrack::report::atomic;
 use peopletrack::run::RunOptions;
 
@@ -29,6 +35,61 @@ pub enum Model {
     /// model on other logs with `model = "PATH"` in the pipeline file (and `webcams = []` when
     /// those logs have no measurement system): per-frame estimates go to estimates.csv.
     OmniAppearance(OmniArgs),
+    /// A random-forest leg detector for 2-D laser scans (the `learned` methods of
+    /// pipelines/laser_people.toml).
+    ///
+    /// Each scan is cut into segments (jump distance 0.1 m, ≥ 3 points); a segment is
+    /// described by 12 features (points, spread, width, linearity, circularity, fitted radius,
+    /// boundary length and regularity, mean curvature, two occlusion flags, range).
+    ///
+    /// --source real reads leg_tracker's training CSVs (Leigh et al., ICRA 2015) in --dir:
+    /// positive_K_scans.csv + positive_K_legs.csv (labelled leg centroids; the nearest
+    /// segment within 0.1 m of a label is a leg) and negative_K_scans.csv (people-free scans;
+    /// every 50th segment is a non-leg). --source synthetic reads synthetic logs with
+    /// /ground_truth/people (legs: segments near a ground-truth leg; non-legs: segments
+    /// farther than 0.5 m from every leg, within 5 m).
+    ///
+    /// Prints and writes (TABLE, default: the model's path with .cv.csv) precision, recall
+    /// and F1 of k-fold cross-validation grouped by file, so that scans of one recording never
+    /// sit on both sides; the probability threshold is the one with the best out-of-fold F1.
+    /// The final model (all samples) is saved as JSON with its threshold and CV scores. The
+    /// same seed gives the same model. The pipeline trains the same model itself (it does not
+    /// load model files): this command shows and saves it, e.g. to train on your own CSVs.
+    ///
+    /// Example: peopletrack train leg-detector --out models/legs.json
+    LegDetector(LegArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct LegArgs {
+    /// Where to write the model (JSON).
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+    /// Training data: the leg_tracker CSVs (real) or synthetic logs with ground truth.
+    #[arg(long, value_enum, default_value = "real")]
+    pub source: LegSource,
+    /// Folder of the leg_tracker training CSVs (--source real).
+    #[arg(long, default_value = "../shared/real/laser/leg_training")]
+    pub dir: PathBuf,
+    /// Synthetic logs (glob; repeat for more; --source synthetic).
+    #[arg(long, value_name = "GLOB", default_values = ["datasets/segway_park/*.mcap", "datasets/office_network/*.mcap"])]
+    pub sessions: Vec<String>,
+    /// Cross-validation folds (grouped by file).
+    #[arg(long, default_value_t = 3)]
+    pub folds: usize,
+    #[arg(long, default_value_t = 100)]
+    pub trees: u16,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Where to write the cross-validation table (CSV).
+    #[arg(long, value_name = "TABLE")]
+    pub table: Option<PathBuf>,
+}
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum LegSource {
+    Real,
+    Synthetic,
 }
 
 #[derive(Debug, clap::Args)]
@@ -51,7 +112,10 @@ pub struct OmniArgs {
 }
 
 pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
-    let Model::OmniAppearance(a) = &a.model;
+    let a = match &a.model {
+        Model::OmniAppearance(a) => a,
+        Model::LegDetector(l) => return leg_detector(l, out),
+    };
     let opts = RunOptions {
         sessions: Some(a.sessions.clone()),
         dry_run: false,
@@ -86,5 +150,84 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     for (session, why) in &s.skipped {
         eprintln!("warning: skipped {session}: {why}");
     }
+    Ok(())
+}
+
+fn leg_detector(a: &LegArgs, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
+    use std::fmt::Write as _;
+    let p = LearnedParams {
+        training_dir: a.dir.display().to_string(),
+        synthetic_sessions: a.sessions.clone(),
+        folds: a.folds,
+        n_trees: a.trees,
+        seed: a.seed,
+        ..LearnedParams::default()
+    };
+    anyhow::ensure!(
+        a.folds >= 2 && a.trees >= 1,
+        "--folds must be ≥ 2 and --trees ≥ 1"
+    );
+    let source = match a.source {
+        LegSource::Real => Source::Real,
+        LegSource::Synthetic => Source::Synthetic,
+    };
+    let model = match learned::train_source(source, &p, "/scan", PEOPLE_TOPIC) {
+        Ok(m) => m,
+        Err(Unavailable::Absent(why) | Unavailable::Failed(why)) => anyhow::bail!("{why}"),
+    };
+    let json = serde_json::to_vec(&*model)?;
+    atomic::write_atomic(&a.out, &json, None)
+        .with_context(|| format!("writing {}", a.out.display()))?;
+    let mut csv = String::from(
+        "source,fold,test_groups,test_legs,test_non_legs,precision,recall,f1,threshold\n",
+    );
+    writeln!(
+        out,
+        "{} leg detector: {} legs, {} non-legs ({} labels without a segment), threshold {:.2}",
+        source.name(),
+        model.positives,
+        model.negatives,
+        model.unmatched_labels,
+        model.threshold
+    )?;
+    writeln!(
+        out,
+        "  {:<8} {:>6} {:>8} {:>9} {:>7} {:>6}  test groups",
+        "fold", "legs", "non-legs", "precision", "recall", "F1"
+    )?;
+    for f in &model.cv {
+        writeln!(
+            out,
+            "  {:<8} {:>6} {:>8} {:>9.3} {:>7.3} {:>6.3}  {}",
+            f.fold,
+            f.positives,
+            f.negatives,
+            f.precision,
+            f.recall,
+            f.f1,
+            f.groups.join(" ")
+        )?;
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{:.4},{:.4},{:.4},{:.2}",
+            source.name(),
+            f.fold,
+            f.groups.join(" "),
+            f.positives,
+            f.negatives,
+            f.precision,
+            f.recall,
+            f.f1,
+            model.threshold
+        );
+    }
+    let table = a
+        .table
+        .clone()
+        .unwrap_or_else(|| a.out.with_extension("cv.csv"));
+    atomic::write_atomic(&table, csv.as_bytes(), None)
+        .with_context(|| format!("writing {}", table.display()))?;
+    writeln!(out, "  model  {}", a.out.display())?;
+    writeln!(out, "  table  {}", table.display())?;
     Ok(())
 }

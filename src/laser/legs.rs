@@ -202,7 +202,7 @@ fn end_kind(nb: Option<&ScanPoint>, beam: usize, end: &ScanPoint, jump: f64) -> 
 }
 
 /// Greedy closest-first pairing; returns the people and the unpaired legs' indices.
-fn pair(legs: &[Leg], pair_distance: f64) -> (Vec<Person>, Vec<usize>) {
+pub fn pair(legs: &[Leg], pair_distance: f64) -> (Vec<Person>, Vec<usize>) {
     let mut candidates: Vec<(f64, usize, usize)> = Vec::new();
     for i in 0..legs.len() {
         for j in i + 1..legs.len() {

@@ -15,6 +15,9 @@
 //!    person from [`crate::track::kalman`], global nearest neighbour with a Mahalanobis gate
 //!    through [`crate::assign`], M-of-N initiation and deletion, single-leg updates).
 //!
+//! [`training`] builds labelled segment samples for a learned leg detector (leg_tracker's
+//! training CSVs, parsed from text; synthetic ground-truth legs).
+//!
 //! No file I/O and no `log`/`frames` imports: a pipeline turns a
 //! `frames::laser::LaserFrame` into [`points::ScanGeometry`] + ranges + pose. Nothing here
 //! panics on NaN or infinite input.
@@ -25,6 +28,7 @@ pub mod legs;
 pub mod points;
 pub mod segment;
 pub mod tracker;
+pub mod training;
 
 #[cfg(test)]
 mod tests;

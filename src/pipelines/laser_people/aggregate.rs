@@ -8,8 +8,9 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use super::params::{Params, Sequence};
+use super::classifier;
 use super::methods::Method;
+use super::params::{Params, Sequence};
 use super::tables::{self, ScanRow, SessionRow, TrackRow, TruthRow};
 use crate::eval::mot::{EventKind, Geometry, GroundPoint, MatchRule, Observation, evaluate};
 use crate::eval::stats::paired_t;
@@ -253,14 +254,18 @@ fn fmt_opt(v: Option<f64>, decimals: usize) -> String {
 pub(super) fn run(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     let data = load(ctx)?;
     let mut out = Products::default();
+    let (active, skipped_methods) = split_methods(p);
     let (mut results, mut tests, mut sessions) = (Vec::new(), Vec::new(), Vec::new());
     for d in &data {
         let seq = p.sequence(&d.name);
-        let scored: Vec<Scored> = p
-            .methods
+        let scored: Vec<Scored> = active
             .iter()
             .map(|m| score(d, seq, m.name(), p.match_m))
             .collect::<anyhow::Result<_>>()?;
+        results.extend(skipped_methods.iter().map(|(m, why)| ResultRow {
+            status: format!("SKIPPED: {why}"),
+            ..skipped_rows(&d.name, &[*m]).remove(0)
+        }));
         for (i, a) in scored.iter().enumerate() {
             for b in &scored[i + 1..] {
                 tests.push(ttest(d, a, b, p.level));
@@ -283,7 +288,7 @@ pub(super) fn run(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
             }
         }
         results.extend(scored.into_iter().map(|s| s.row));
-        for m in &p.methods {
+        for m in &active {
             out.artifacts.push((
                 PathBuf::from(format!("tracks/{}_{}.csv", sanitize(&d.name), m.name())),
                 tracks_csv(&d.tracks, m.name()),
@@ -314,7 +319,22 @@ pub(super) fn run(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
         }
     }
     push_tables(&mut out, p, &results, &tests, &sessions)?;
+    classifier::products(p, &mut out)?;
     Ok(out)
+}
+
+/// The methods to score, and those skipped with the reason (a learned method whose training
+/// data is absent).
+fn split_methods(p: &Params) -> (Vec<Method>, Vec<(Method, String)>) {
+    let mut active = Vec::new();
+    let mut skipped = Vec::new();
+    for &m in &p.methods {
+        match classifier::skip_reason(m, p) {
+            Some(why) => skipped.push((m, why)),
+            None => active.push(m),
+        }
+    }
+    (active, skipped)
 }
 
 fn describe(s: &Sequence) -> String {

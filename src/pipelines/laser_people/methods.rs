@@ -7,14 +7,28 @@
 //! - **`legs_jpda`**: the same with JPDA association ([`Association::Jpda`] at its defaults).
 //! - **`legs_leg_limit`**: `legs` where single legs carry a track for at most
 //!   [`LEG_ONLY_SCANS`] scans after its last leg-pair update (`max_leg_only_scans`).
+//! - **`learned`** / **`learned_synthetic`**: every segment through the random-forest leg
+//!   classifier of [`super::learned`] (trained on the real leg_tracker CSVs / on the synthetic
+//!   datasets; a leg when its probability reaches the threshold chosen by cross-validation),
+//!   the legs paired into people as the seed 002 model pairs them ([`legs::pair`]) →
+//!   [`PeopleTracker`]. A leg's position is its fitted circle's centre when a circle of radius
+//!   ≤ [`LEARNED_MAX_RADIUS_M`] fits facing the laser, else the segment's centroid.
 //! - **`nearest`**: the baseline without a filter: the midpoint of the two legs nearest to the
 //!   laser (any distance apart), one hypothesis with id 1 on each scan with two legs or more.
 //!
 //! A new method is a variant of [`Method`] (its name in the pipeline file) and of [`Runner`]
 //! (its state across the scans of one session).
 
+use std::sync::Arc;
+
 use nalgebra::Point2;
 use serde::{Deserialize, Serialize};
+
+use super::learned::{self, LearnedParams, LegModel, Source, Unavailable};
+use crate::laser::features;
+use crate::laser::legs::Leg;
+use crate::laser::points::to_fixed;
+use crate::laser::training::{Segmented, centroid, sample_features};
 
 use crate::frames::laser::LaserFrame;
 use crate::laser::legs::{self, Detections, LegParams};
@@ -30,6 +44,8 @@ pub enum Method {
     LegsJpda,
     LegsLegLimit,
     Nearest,
+    Learned,
+    LearnedSynthetic,
 }
 
 impl Method {
@@ -40,6 +56,8 @@ impl Method {
             Method::LegsJpda => "legs_jpda",
             Method::LegsLegLimit => "legs_leg_limit",
             Method::Nearest => "nearest",
+            Method::Learned => "learned",
+            Method::LearnedSynthetic => "learned_synthetic",
         }
     }
 
@@ -52,13 +70,31 @@ impl Method {
             Method::Nearest => {
                 "midpoint of the two legs nearest to the laser, no filter, one id (the baseline)"
             }
+            Method::Learned => {
+                "random-forest leg classifier trained on the real leg_tracker CSVs, seed 002 pairing + PeopleTracker"
+            }
+            Method::LearnedSynthetic => {
+                "the same classifier trained on the synthetic datasets only (in-sample on the synthetic sequences), seed 002 pairing + PeopleTracker"
+            }
+        }
+    }
+
+    /// The training data of a learned method.
+    pub fn source(self) -> Option<Source> {
+        match self {
+            Method::Learned => Some(Source::Real),
+            Method::LearnedSynthetic => Some(Source::Synthetic),
+            _ => None,
         }
     }
 }
 
+/// Largest fitted radius (m) a learned leg's position is taken from (the circle's centre);
+/// above it, the segment's centroid.
+pub const LEARNED_MAX_RADIUS_M: f64 = 0.15;
+
 /// One scan as every method sees it: its returns, segments and the seed 002 leg model's
 /// detections, computed once.
-#[allow(dead_code)] // frame, points and segments are for methods with their own leg detector
 pub struct ScanView<'a> {
     pub frame: &'a LaserFrame,
     pub points: Vec<ScanPoint>,
@@ -106,12 +142,22 @@ pub struct Hypothesis {
 pub enum Runner {
     Tracked(Box<PeopleTracker>),
     Nearest,
+    Learned(Arc<LegModel>, Box<PeopleTracker>),
 }
 
 impl Runner {
-    pub fn new(method: Method) -> Runner {
-        match method {
-            Method::Legs => Runner::Tracked(Box::new(PeopleTracker::new(TrackerParams::default()))),
+    /// The method's runner; `None` when a learned method's training data is absent (its rows
+    /// say SKIPPED); an error when its training failed.
+    /// `scan_topic` and `gt_topic` are those of the synthetic training logs.
+    pub fn new(
+        method: Method,
+        p: &LearnedParams,
+        scan_topic: &str,
+        gt_topic: &str,
+    ) -> anyhow::Result<Option<Runner>> {
+        let tracker = || Box::new(PeopleTracker::new(TrackerParams::default()));
+        Ok(Some(match method {
+            Method::Legs => Runner::Tracked(tracker()),
             Method::LegsJpda => Runner::Tracked(Box::new(PeopleTracker::new(TrackerParams {
                 association: Association::Jpda(JpdaParams::default()),
                 ..TrackerParams::default()
@@ -121,7 +167,17 @@ impl Runner {
                 ..TrackerParams::default()
             }))),
             Method::Nearest => Runner::Nearest,
-        }
+            Method::Learned | Method::LearnedSynthetic => {
+                let source = method.source().unwrap_or(Source::Real);
+                match learned::model(source, p, scan_topic, gt_topic) {
+                    Ok(m) => Runner::Learned(m, tracker()),
+                    Err(Unavailable::Absent(_)) => return Ok(None),
+                    Err(Unavailable::Failed(e)) => {
+                        anyhow::bail!("training the {} leg detector: {e}", method.name())
+                    }
+                }
+            }
+        }))
     }
 
     /// The method's hypotheses after scan `view` at `time_s` (s since the session's first
@@ -129,6 +185,10 @@ impl Runner {
     pub fn step(&mut self, view: &ScanView, time_s: f64) -> Vec<Hypothesis> {
         match self {
             Runner::Tracked(tracker) => track(tracker, &view.geometric, time_s),
+            Runner::Learned(model, tracker) => {
+                let d = learned_legs(model, view);
+                track(tracker, &d, time_s)
+            }
             Runner::Nearest => nearest_pair(&view.geometric)
                 .map(|(laser, world)| Hypothesis {
                     id: 1,
@@ -138,6 +198,56 @@ impl Runner {
                 .into_iter()
                 .collect(),
         }
+    }
+}
+
+/// The legs the classifier finds among the scan's segments, paired as seed 002 pairs them.
+/// A classifier error (a model of another feature width) finds no legs.
+fn learned_legs(model: &LegModel, view: &ScanView) -> Detections {
+    let s = Segmented {
+        points: view.points.clone(),
+        segments: view.segments.clone(),
+        centroids: view
+            .segments
+            .iter()
+            .map(|g| centroid(&view.points, g))
+            .collect(),
+    };
+    let x: Vec<Vec<f64>> = (0..s.segments.len())
+        .map(|i| sample_features(&s, i))
+        .collect();
+    let prob = model.probability(&x).unwrap_or_default();
+    let pose = view.frame.pose.as_ref();
+    let legs: Vec<Leg> = prob
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| **p >= model.threshold)
+        .map(|(i, _)| {
+            let features = features::compute(&s.points, &s.segments[i]);
+            let c = s.centroids[i];
+            let (sensor, radius) = match features.circle {
+                Some(k)
+                    if k.radius <= LEARNED_MAX_RADIUS_M
+                        && k.centre.coords.norm() > c.coords.norm() =>
+                {
+                    (k.centre, k.radius)
+                }
+                _ => (c, 0.0),
+            };
+            Leg {
+                segment: s.segments[i].clone(),
+                features,
+                sensor,
+                fixed: to_fixed(pose, sensor),
+                radius,
+            }
+        })
+        .collect();
+    let (people, single_legs) = legs::pair(&legs, LegParams::default().pair_distance);
+    Detections {
+        legs,
+        people,
+        single_legs,
     }
 }
 

@@ -12,17 +12,21 @@
 //! are absent get SKIPPED rows.
 
 mod aggregate;
+mod classifier;
+pub mod learned;
 mod methods;
 mod params;
 mod session;
 mod tables;
 
 use std::collections::BTreeMap;
+use std::path::PathBuf;
 
 use crate::progress::Progress;
 use crate::run::config::Invalid;
 use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
 
+pub use learned::LearnedParams;
 pub use params::{Params, Sequence};
 
 pub struct LaserPeople;
@@ -59,6 +63,22 @@ impl Experiment for LaserPeople {
                 optional: gt,
             },
         ]
+    }
+
+    /// The learned detectors' training data (read when the first session or the aggregation
+    /// trains them; see [`learned`]): the real training folder and the synthetic logs only
+    /// when a learned method is listed.
+    fn external_inputs(p: &Params) -> Vec<PathBuf> {
+        let mut out = Vec::new();
+        if p.methods.contains(&methods::Method::Learned) {
+            out.push(PathBuf::from(&p.learned.training_dir));
+        }
+        if p.methods.contains(&methods::Method::LearnedSynthetic) {
+            for g in &p.learned.synthetic_sessions {
+                out.extend(glob::glob(g).into_iter().flatten().flatten());
+            }
+        }
+        out
     }
 
     fn process(

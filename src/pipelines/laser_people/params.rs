@@ -4,6 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::learned::LearnedParams;
 use super::methods::Method;
 use crate::groundtruth::PEOPLE_TOPIC;
 use crate::run::config::Invalid;
@@ -50,6 +51,8 @@ pub struct Params {
     pub synthetic: Sequence,
     /// The methods run on every scan, in table order (see [`super::methods`]).
     pub methods: Vec<Method>,
+    /// Training of the learned leg detectors (`learned`, `learned_synthetic`).
+    pub learned: LearnedParams,
 }
 
 impl Default for Params {
@@ -68,6 +71,7 @@ impl Default for Params {
                 max_range_m: None,
             },
             methods: vec![Method::Legs, Method::Nearest],
+            learned: LearnedParams::default(),
         }
     }
 }
@@ -169,6 +173,24 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
         check_sequence(&key, s, &mut out);
     }
     check_sequence("synthetic", &p.synthetic, &mut out);
+    let l = &p.learned;
+    if l.folds < 2
+        || l.n_trees == 0
+        || l.negative_keep_every == 0
+        || l.synthetic_scan_every == 0
+        || l.synthetic_negative_keep_every == 0
+    {
+        out.push((
+            "learned".into(),
+            "folds ≥ 2 and n_trees, negative_keep_every, synthetic_scan_every, synthetic_negative_keep_every ≥ 1".into(),
+        ));
+    }
+    if !(l.max_range_m.is_finite() && l.max_range_m > 0.0) {
+        out.push((
+            "learned".into(),
+            format!("max_range_m {} must be finite and > 0", l.max_range_m),
+        ));
+    }
     if p.methods.is_empty() {
         out.push(("methods".into(), "needs at least one method".into()));
     }

@@ -198,8 +198,17 @@ pub(super) fn process(
         .zip(summary.statistics.as_ref())
         .and_then(|(c, st)| st.channel_message_counts.get(&c.id).copied());
     bar.set_length(expected.unwrap_or(0));
-    let mut runners: Vec<(Method, Runner)> =
-        p.methods.iter().map(|&m| (m, Runner::new(m))).collect();
+    let mut runners: Vec<(Method, Runner)> = Vec::new();
+    for &m in &p.methods {
+        if let Some(r) = Runner::new(
+            m,
+            &p.learned,
+            &p.synthetic.scan_topic,
+            &p.synthetic.gt_topic,
+        )? {
+            runners.push((m, r));
+        }
+    }
     let mut out = Collected::default();
     let mut first: Option<Nanos> = None;
     for (idx, f) in frames.by_ref().enumerate() {
