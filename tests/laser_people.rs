@@ -14,8 +14,10 @@ use peopletrack::Nanos;
 use peopletrack::groundtruth::{
     PEOPLE_JSON_SCHEMA, PEOPLE_SCHEMA, PEOPLE_TOPIC, PeopleFrame, PersonTruth,
 };
-use peopletrack::log::msgs::{Header, LaserScan, TfMessage, Transform, TransformStamped};
-use peopletrack::log::{SessionWriter, Value, WriterOptions};
+use peopletrack::log::msgs::{
+    Header, LaserScan, Marker, MarkerArray, TfMessage, Transform, TransformStamped,
+};
+use peopletrack::log::{SessionLog, SessionWriter, Value, WriterOptions, read_topic};
 use peopletrack::pipelines::run_file;
 use peopletrack::report::columns::i64s;
 use peopletrack::report::table::read_parquet;
@@ -373,6 +375,101 @@ fn leg_tracker_annotations_score_the_same() {
     assert_eq!(sessions[0]["gt_kind"], "leg_tracker");
     assert_eq!(sessions[0]["fixed_frame"], "laser");
     assert_eq!(sessions[0]["gt_rows"], "20");
+}
+
+/// `--write-tracks`: a copy of the two-walker log with one MarkerArray per scan and method on
+/// `/peopletrack/laser_people/<method>/markers`, in the scan's frame at its stamp: `DELETEALL`,
+/// then a sphere and an id label per track. `legs` has both walkers on the 8 scans after
+/// confirmation (16 tracks: 10 + 2 × 16 markers), `nearest` the nearer walker (id 1) on all 10
+/// scans at the midpoint of its legs (10 + 2 × 10); the spheres sit where the tracks CSV
+/// says, and every message of the original is in the copy unchanged.
+#[test]
+fn tracks_go_back_into_a_copy_of_the_log_as_markers() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let data = dir.path().join("walkers");
+    std::fs::create_dir_all(&data).expect("mkdir");
+    let input = data.join("walkers_00.mcap");
+    write_log(&input, false);
+    let toml = dir.path().join("laser_people.toml");
+    std::fs::write(&toml, PIPELINE).expect("write pipeline");
+    let out = dir.path().join("out");
+    let copies = dir.path().join("copies");
+    let mut opts = options(&out, vec![format!("{}/*.mcap", data.display())]);
+    opts.write_tracks = Some(copies.clone());
+    let summary = run_file(&toml, &opts).expect("runs");
+    assert!(summary.skipped.is_empty(), "{:?}", summary.skipped);
+    let copy = copies.join("walkers/walkers_00_laser_people.mcap");
+    let log = SessionLog::open(&copy).expect("the copy reads back");
+    let arrays = |method: &str| -> Vec<(Nanos, MarkerArray)> {
+        read_topic::<MarkerArray>(&log, &format!("/peopletrack/laser_people/{method}/markers"))
+            .expect("marker topic")
+            .map(|r| r.expect("decodes"))
+            .collect()
+    };
+    let scan_time = |i: u64| Nanos(1_000_000_000 + i * 100_000_000);
+    let legs_csv = csv_rows(&out.join("laser_people/tracks/walkers_00_legs.csv"));
+    for (method, per_scan, total) in [("legs", None, 42), ("nearest", Some(1), 30)] {
+        let got = arrays(method);
+        assert_eq!(got.len(), SCANS as usize, "{method}");
+        let markers: usize = got.iter().map(|(_, a)| a.markers.len()).sum();
+        assert_eq!(markers, total, "{method}");
+        for (i, (t, a)) in got.iter().enumerate() {
+            let i = i as u64;
+            assert_eq!(*t, scan_time(i), "{method}: logged at the scan's log time");
+            assert_eq!(a.markers[0].action, Marker::DELETEALL);
+            for m in &a.markers {
+                assert_eq!(m.header.frame_id, "laser");
+                assert_eq!(m.header.stamp.nanos(), Some(scan_time(i)));
+            }
+            let spheres: Vec<&Marker> = a.markers.iter().filter(|m| m.ns == "tracks").collect();
+            let labels: Vec<&Marker> = a.markers.iter().filter(|m| m.ns == "ids").collect();
+            assert!(spheres.iter().all(|m| m.kind == Marker::SPHERE));
+            assert!(labels.iter().all(|m| m.kind == Marker::TEXT_VIEW_FACING));
+            let ids: Vec<i32> = spheres.iter().map(|m| m.id).collect();
+            let texts: Vec<String> = labels.iter().map(|m| m.text.clone()).collect();
+            assert_eq!(texts, ids.iter().map(i32::to_string).collect::<Vec<_>>());
+            match per_scan {
+                // nearest: id 1 at the nearer walker's centre on every scan
+                Some(id) => {
+                    assert_eq!(ids, [id]);
+                    let c = centre(0, i);
+                    let p = spheres[0].pose.position;
+                    assert!((p.x - c[0]).hypot(p.y - c[1]) < 1e-3, "{method} scan {i}: {p}");
+                }
+                // legs: exactly the rows of the tracks CSV on this scan
+                None => {
+                    let rows: Vec<_> = legs_csv
+                        .iter()
+                        .filter(|r| r["scan_idx"] == i.to_string())
+                        .collect();
+                    assert_eq!(ids.len(), rows.len(), "legs scan {i}");
+                    assert_eq!(rows.len(), if i >= 2 { 2 } else { 0 }, "legs scan {i}");
+                    for (m, r) in spheres.iter().zip(&rows) {
+                        assert_eq!(m.id.to_string(), r["id"]);
+                        let x: f64 = r["x"].parse().expect("x");
+                        let y: f64 = r["y"].parse().expect("y");
+                        let p = m.pose.position;
+                        assert!((p.x - x).abs() <= 5e-5 && (p.y - y).abs() <= 5e-5);
+                    }
+                }
+            }
+        }
+    }
+    // every original message, unchanged and in order
+    let messages = |path: &Path, skip_markers: bool| -> Vec<(String, u64, Vec<u8>)> {
+        SessionLog::open(path)
+            .expect("open")
+            .messages()
+            .expect("messages")
+            .map(|m| m.expect("message"))
+            .filter(|m| !(skip_markers && m.channel.topic.starts_with("/peopletrack/")))
+            .map(|m| (m.channel.topic.clone(), m.log_time.0, m.data.to_vec()))
+            .collect()
+    };
+    let original = messages(&input, false);
+    assert_eq!(original.len(), 21); // tf_static + 10 scans + 10 ground-truth frames
+    assert_eq!(messages(&copy, true), original);
+    assert_eq!(messages(&copy, false).len(), 21 + 2 * SCANS as usize);
 }
 
 /// Bad input: a session without its laser topic is a listed skip naming the topic; NaN, ±inf

@@ -31,8 +31,9 @@ pub struct Args {
     pub out: PathBuf,
     /// Write the tracks back into a copy of each log (as visualization_msgs/msg/MarkerArray,
     /// for Foxglove) under DIR (default: <out>/tracks), for pipelines that produce tracks.
-    #[arg(long, value_name = "DIR", num_args = 0..=1, default_missing_value = "")]
-    pub write_tracks: Option<PathBuf>,
+    /// (Given without DIR it is `Some(None)`: a path value parser rejects an empty default.)
+    #[arg(long, value_name = "DIR", num_args = 0..=1)]
+    pub write_tracks: Option<Option<PathBuf>>,
 }
 
 fn parse_shard(s: &str) -> Result<(usize, usize), String> {
@@ -57,13 +58,10 @@ pub fn options(a: &Args, progress: bool) -> RunOptions {
         out: a.out.clone(),
         git_commit: super::git_commit(),
         progress: super::progress::shared(progress),
-        write_tracks: a.write_tracks.as_ref().map(|d| {
-            if d.as_os_str().is_empty() {
-                a.out.join("tracks")
-            } else {
-                d.clone()
-            }
-        }),
+        write_tracks: a
+            .write_tracks
+            .as_ref()
+            .map(|d| d.clone().unwrap_or_else(|| a.out.join("tracks"))),
     }
 }
 
@@ -97,4 +95,40 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         eprintln!("warning: skipped {session}: {why}");
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        run: Args,
+    }
+
+    fn write_tracks(args: &[&str]) -> Option<PathBuf> {
+        let cli = Cli::try_parse_from(args).expect("parses");
+        options(&cli.run, false).write_tracks
+    }
+
+    /// Regression: a bare `--write-tracks` was rejected ("a value is required") because the
+    /// empty default value does not parse as a path.
+    #[test]
+    fn write_tracks_without_a_folder_goes_under_out() {
+        assert_eq!(
+            write_tracks(&["run", "p.toml", "--write-tracks"]),
+            Some(PathBuf::from("out/tracks"))
+        );
+        assert_eq!(
+            write_tracks(&["run", "p.toml", "--out", "o", "--write-tracks"]),
+            Some(PathBuf::from("o/tracks"))
+        );
+        assert_eq!(
+            write_tracks(&["run", "p.toml", "--write-tracks", "d"]),
+            Some(PathBuf::from("d"))
+        );
+        assert_eq!(write_tracks(&["run", "p.toml"]), None);
+    }
 }

@@ -8,10 +8,12 @@
 //! - [`decode`]: which decoder reads which channel, and typed reads on top.
 //! - [`msgs`]: typed forms of the ROS 2 messages pipelines consume; [`image`] decodes images.
 //! - [`tf`]: the transform tree with interpolated lookups; [`sync`]: nearest-stamp joins.
-//! - [`writer`]: sessions as `ros2 bag record` writes them; [`definitions`]: their schemas.
+//! - [`writer`]: sessions as `ros2 bag record` writes them; [`definitions`]: their schemas;
+//!   [`copy`]: a copy of a log with messages added (tracks written back as markers).
 
 mod camera_info;
 pub mod cdr;
+pub mod copy;
 pub mod decode;
 pub mod definitions;
 mod error;

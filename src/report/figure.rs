@@ -7,7 +7,9 @@
 //! - [`ScatterPlot`]: points per series with an annotation (e.g. Pearson r) and a fit line;
 //! - [`TopView`]: room outline, obstacles, sensors, trajectories and cylinders, equal aspect;
 //! - [`BarPlot`]: bars with error bars and significance marks;
-//! - [`ImageOverlay`]: a camera image with boxes, ellipses and polylines (projected cylinders).
+//! - [`ImageOverlay`]: a camera image with boxes, ellipses and polylines (projected cylinders);
+//! - [`GroupedBars`]: bars in groups with a legend (a metric per sequence and method);
+//! - [`Panels`]: figures side by side in a grid under one title.
 //!
 //! Colours are the Okabe–Ito palette (distinguishable with colour-vision deficiency).
 
@@ -29,14 +31,15 @@ fn register_font() {
 }
 
 mod draw;
+mod grouped;
 mod spec;
 
 #[cfg(test)]
 use draw::emptiest_corner;
 pub use draw::least_squares;
 pub use spec::{
-    Bar, BarPlot, Circle, Event, Figure, FigureKind, ImageOverlay, LinePlot, Mark, Overlay,
-    PALETTE, ScatterPlot, Sensor, Series, Significance, TopView, color,
+    Bar, BarPlot, Circle, Event, Figure, FigureKind, GroupedBars, ImageOverlay, LinePlot, Mark,
+    Overlay, PALETTE, Panels, ScatterPlot, Sensor, Series, Significance, TopView, color,
 };
 
 #[derive(Debug, thiserror::Error)]

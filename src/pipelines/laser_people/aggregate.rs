@@ -1,8 +1,8 @@
 //! The aggregation, from the cached per-session tables only: CLEAR MOT, IDF1 and HOTA per
 //! sequence × detector in the laser frame under each sequence's protocol (scored scans,
 //! wedge, range), paired t-tests of the per-scan position errors of every two methods, the
-//! sessions' reading statistics, and the tracks as CSV. A listed real sequence without
-//! results gets SKIPPED rows.
+//! sessions' reading statistics, and the tracks as CSV (the figures and the marker export use
+//! its rows). A listed real sequence without results gets SKIPPED rows.
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -82,13 +82,13 @@ table_row! {
 }
 
 /// One session's cached rows.
-struct SessionData {
-    dataset: String,
-    name: String,
-    session: SessionRow,
-    scans: Vec<ScanRow>,
-    truth: Vec<TruthRow>,
-    tracks: Vec<TrackRow>,
+pub(super) struct SessionData {
+    pub dataset: String,
+    pub name: String,
+    pub session: SessionRow,
+    pub scans: Vec<ScanRow>,
+    pub truth: Vec<TruthRow>,
+    pub tracks: Vec<TrackRow>,
 }
 
 fn point(frame: i64, id: i64, x: f64, y: f64) -> Observation {
@@ -225,6 +225,7 @@ pub fn tracks_csv(tracks: &[TrackRow], detector: &str) -> Vec<u8> {
     s.into_bytes()
 }
 
+/// Every session's rows, in the order of `ctx.sessions`.
 fn load(ctx: &Aggregate) -> anyhow::Result<Vec<SessionData>> {
     ctx.sessions
         .iter()
@@ -251,7 +252,11 @@ fn fmt_opt(v: Option<f64>, decimals: usize) -> String {
         .map_or_else(|| "n/a".into(), |x| format!("{x:.decimals$}"))
 }
 
-pub(super) fn run(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
+/// The tables, with the rows the figures and the marker export use.
+pub(super) fn run(
+    ctx: &Aggregate,
+    p: &Params,
+) -> anyhow::Result<(Products, Vec<SessionData>, Vec<ResultRow>)> {
     let data = load(ctx)?;
     let mut out = Products::default();
     let (active, skipped_methods) = split_methods(p);
@@ -320,7 +325,7 @@ pub(super) fn run(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     }
     push_tables(&mut out, p, &results, &tests, &sessions)?;
     classifier::products(p, &mut out)?;
-    Ok(out)
+    Ok((out, data, results))
 }
 
 /// The methods to score, and those skipped with the reason (a learned method whose training

@@ -7,17 +7,23 @@
 //! one id), with the ground truth on its scans, all in the laser frame. The aggregation
 //! ([`aggregate`]) scores each sequence × method with CLEAR MOT, IDF1 and HOTA under the
 //! sequence's protocol ([`params::Sequence`]: scored scans, bearing wedge, range), runs paired
-//! t-tests of the methods' position errors, and writes the tracks as CSV. The real sequences
+//! t-tests of the methods' position errors, writes the tracks as CSV, draws the figures
+//! ([`figures`]: a top view per sequence, MOTA and MOTP per method; from the poses and sampled
+//! returns that [`view`] caches), and with `--write-tracks` writes the tracks back into copies
+//! of the logs as Foxglove markers ([`markers`]). The real sequences
 //! (Leigh et al., ICRA 2015) are read in place from `../shared/real/laser/`; listed ones that
 //! are absent get SKIPPED rows.
 
 mod aggregate;
 mod classifier;
 pub mod learned;
+mod figures;
+mod markers;
 mod methods;
 mod params;
 mod session;
 mod tables;
+mod view;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -33,7 +39,7 @@ pub struct LaserPeople;
 
 impl Experiment for LaserPeople {
     const KIND: &'static str = "laser_people";
-    const VERSION: u32 = 2;
+    const VERSION: u32 = 3;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {
@@ -91,6 +97,11 @@ impl Experiment for LaserPeople {
     }
 
     fn aggregate(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
-        aggregate::run(ctx, p)
+        let (mut out, data, results) = aggregate::run(ctx, p)?;
+        out.figures.extend(figures::all(ctx, p, &data, &results)?);
+        if let Some(dir) = ctx.write_tracks {
+            out.summary.extend(markers::export(ctx, p, &data, dir)?);
+        }
+        Ok(out)
     }
 }

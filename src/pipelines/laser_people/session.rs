@@ -17,6 +17,7 @@ use nalgebra::{Isometry3, Point2, Point3};
 use super::methods::{Method, Runner, ScanView};
 use super::params::{Params, Sequence};
 use super::tables::{self, ScanRow, SessionRow, TrackRow, TruthRow};
+use super::view;
 use crate::frames::laser::{self as laser_frames, LaserFrame, LaserOptions};
 use crate::frames::{Skips, truth};
 use crate::log::SessionLog;
@@ -62,6 +63,8 @@ struct Collected {
     truth: Vec<TruthRow>,
     tracks: Vec<TrackRow>,
     gt_dropped: i64,
+    /// Poses and sampled returns for the figures and markers.
+    view: view::Collector,
 }
 
 /// A fixed-frame point in the laser frame (identity without a pose).
@@ -105,6 +108,7 @@ fn scan_step(
     let view = ScanView::new(f);
     let d = &view.geometric;
     let pose = f.pose.as_ref();
+    out.view.observe(idx, f, &view.points);
     for (method, runner) in runners.iter_mut() {
         for h in runner.step(&view, time_s) {
             let laser = h.laser.unwrap_or_else(|| to_laser(pose, h.world));
@@ -209,7 +213,10 @@ pub(super) fn process(
             runners.push((m, r));
         }
     }
-    let mut out = Collected::default();
+    let mut out = Collected {
+        view: view::Collector::new(seq.scans),
+        ..Collected::default()
+    };
     let mut first: Option<Nanos> = None;
     for (idx, f) in frames.by_ref().enumerate() {
         let f = f?;
@@ -241,12 +248,14 @@ pub(super) fn process(
         skipped_messages: i64::try_from(skips.total()).unwrap_or(i64::MAX),
         first_error: skips.first_error().map(str::to_string),
     };
-    Ok(SessionTables::from([
+    let mut t = SessionTables::from([
         (tables::SESSION.to_string(), SessionRow::frame(&[session])?),
         (tables::SCANS.to_string(), ScanRow::frame(&out.scans)?),
         (tables::TRUTH.to_string(), TruthRow::frame(&out.truth)?),
         (tables::TRACKS.to_string(), TrackRow::frame(&out.tracks)?),
-    ]))
+    ]);
+    out.view.into_tables(&mut t)?;
+    Ok(t)
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@ use super::Params;
 use super::scored::Scored;
 use super::tables::TrackRow;
 use crate::log::msgs::{Header, Marker, MarkerArray, Pose, Time};
-use crate::log::{ChannelId, SessionLog, SessionWriter, WriterOptions};
+use crate::log::copy::copy_with_messages;
 use crate::report::figure::color;
 use crate::run::Aggregate;
 use crate::time::Nanos;
@@ -87,7 +87,7 @@ pub(crate) fn markers_for(
 }
 
 /// Copy `input` to `output` with the tracks added as markers on `topic`; returns the number of
-/// marker messages written.
+/// marker messages written (the copy itself is [`copy_with_messages`]).
 pub(crate) fn write_tracks(
     input: &Path,
     output: &Path,
@@ -96,50 +96,10 @@ pub(crate) fn write_tracks(
     life_s: f64,
     frames: &[FrameTracks],
 ) -> anyhow::Result<usize> {
-    let log = SessionLog::open(input)?;
-    let mut w = SessionWriter::create(output, &WriterOptions::default())?;
-    for m in &log.summary().metadata {
-        w.metadata(&m.name, m.entries.clone())?;
-    }
-    let mut channels: std::collections::BTreeMap<u16, ChannelId> = Default::default();
-    for (id, ch) in &log.summary().channels {
-        let schema = ch
-            .schema
-            .as_deref()
-            .map(|s| (s.name.as_str(), s.encoding.as_str(), s.data.as_slice()));
-        channels.insert(*id, w.add_raw(&ch.topic, schema, &ch.message_encoding)?);
-    }
-    let markers = w.add_ros2::<MarkerArray>(topic)?;
-    let mut next = 0usize;
-    for m in log.messages()? {
-        let m = m?;
-        while next < frames.len() && frames[next].0 <= m.log_time {
-            let (stamp, tracks) = &frames[next];
-            w.write(
-                markers,
-                *stamp,
-                &markers_for(frame_id, *stamp, life_s, tracks),
-            )?;
-            next += 1;
-        }
-        let ch = channels.get(&m.channel.id).with_context(|| {
-            format!(
-                "{}: channel {} not in the summary",
-                input.display(),
-                m.channel.id
-            )
-        })?;
-        w.write_bytes(*ch, m.log_time, &m.data)?;
-    }
-    for (stamp, tracks) in &frames[next..] {
-        w.write(
-            markers,
-            *stamp,
-            &markers_for(frame_id, *stamp, life_s, tracks),
-        )?;
-    }
-    w.finish()?;
-    Ok(frames.len())
+    let markers = frames
+        .iter()
+        .map(|(stamp, tracks)| (*stamp, 0, markers_for(frame_id, *stamp, life_s, tracks)));
+    Ok(copy_with_messages(input, output, &[topic], markers)?)
 }
 
 /// The folder of the export: `--write-tracks`, else the `write_tracks` parameter; none: no

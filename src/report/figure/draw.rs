@@ -57,7 +57,7 @@ pub(super) fn emptiest_corner(
     best.1
 }
 
-type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
+pub(super) type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
 
 fn bounds(points: impl Iterator<Item = (f64, f64)>) -> Option<(f64, f64, f64, f64)> {
     let mut b: Option<(f64, f64, f64, f64)> = None;
@@ -81,7 +81,7 @@ fn pad(lo: f64, hi: f64) -> (f64, f64) {
     (lo - m, hi + m)
 }
 
-fn caption_style() -> TextStyle<'static> {
+pub(super) fn caption_style() -> TextStyle<'static> {
     ("sans-serif", 18).into_font().color(&BLACK)
 }
 
@@ -100,6 +100,8 @@ impl Figure {
             FigureKind::TopView(p) => self.draw_top(root, p),
             FigureKind::Bars(p) => self.draw_bars(root, p),
             FigureKind::Overlay(p) => self.draw_overlay(root, p, raster),
+            FigureKind::GroupedBars(p) => self.draw_grouped(root, p),
+            FigureKind::Panels(p) => self.draw_panels(root, p, raster),
         }
     }
 
@@ -510,6 +512,12 @@ fn draw_series<DB: DrawingBackend>(
             pts.iter()
                 .map(|p| plotters::element::Circle::new(*p, 3, c.filled())),
         )?,
+        Mark::Dots => {
+            // opaque: the colour at 45 % on white, so overlapping dots stay faint
+            let faint = |v: u8| (f64::from(v) * 0.45 + 255.0 * 0.55) as u8;
+            let f = RGBColor(faint(c.0), faint(c.1), faint(c.2));
+            chart.draw_series(pts.iter().map(|p| Pixel::new(*p, f)))?
+        }
     };
     if !s.name.is_empty() {
         anno.label(s.name.clone())

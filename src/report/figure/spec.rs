@@ -28,6 +28,8 @@ pub enum Mark {
     Points,
     LinePoints,
     Dashed,
+    /// One-pixel points, faded (e.g. a laser's returns under a top view).
+    Dots,
 }
 
 /// One named series.
@@ -189,6 +191,28 @@ pub struct ImageOverlay {
     pub shapes: Vec<Overlay>,
 }
 
+/// Bars in groups (e.g. one group per sequence, one bar per method), a legend of the series.
+#[derive(Debug, Clone, Default)]
+pub struct GroupedBars {
+    pub y_label: String,
+    /// The groups' names, left to right.
+    pub groups: Vec<String>,
+    /// `(name, value per group)`; `None` draws no bar.
+    pub series: Vec<(String, Vec<Option<f64>>)>,
+    /// Text at the end of each bar, `labels[series][group]` (missing or empty: none).
+    pub labels: Vec<Vec<String>>,
+    /// Text under a group's name (e.g. `SKIPPED`), by group (missing or empty: none).
+    pub group_notes: Vec<String>,
+}
+
+/// Figures side by side in a grid, `columns` wide, each with its own title, under the
+/// figure's title. Image overlays in a grid show their shapes only in SVG.
+#[derive(Debug, Clone, Default)]
+pub struct Panels {
+    pub columns: usize,
+    pub panels: Vec<Figure>,
+}
+
 #[derive(Debug, Clone)]
 pub enum FigureKind {
     Lines(LinePlot),
@@ -196,6 +220,8 @@ pub enum FigureKind {
     TopView(TopView),
     Bars(BarPlot),
     Overlay(ImageOverlay),
+    GroupedBars(GroupedBars),
+    Panels(Panels),
 }
 
 /// A figure ready to render.
@@ -213,6 +239,8 @@ impl Figure {
         let size = match &kind {
             FigureKind::Overlay(o) => (o.image.width().max(64), o.image.height().max(64) + 30),
             FigureKind::TopView(_) => (720, 720),
+            FigureKind::GroupedBars(g) => ((140 + 190 * g.groups.len() as u32).max(800), 500),
+            FigureKind::Panels(p) => p.size(),
             _ => (800, 500),
         };
         Figure {
@@ -221,5 +249,16 @@ impl Figure {
             size,
             kind,
         }
+    }
+}
+
+impl Panels {
+    /// The grid's cell is the largest panel's size; 30 px more for the title.
+    pub fn size(&self) -> (u32, u32) {
+        let columns = self.columns.clamp(1, self.panels.len().max(1));
+        let rows = self.panels.len().div_ceil(columns).max(1);
+        let w = self.panels.iter().map(|f| f.size.0).max().unwrap_or(400);
+        let h = self.panels.iter().map(|f| f.size.1).max().unwrap_or(300);
+        (w * columns as u32, h * rows as u32 + 30)
     }
 }

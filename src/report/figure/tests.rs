@@ -233,3 +233,67 @@ fn least_squares_known_answer() {
     assert!((a - 1.0).abs() < 1e-12 && (b - 2.0).abs() < 1e-12);
     assert_eq!(least_squares(&[(1.0, 1.0), (1.0, 2.0)]), None);
 }
+
+/// The colour a fill of `c` at opacity `a` leaves on white (how the bitmap backend blends).
+fn on_white(c: plotters::style::RGBColor, a: f64) -> [u8; 3] {
+    let mix = |v: u8| (f64::from(v) * a + 255.0 * (1.0 - a)) as u8;
+    [mix(c.0), mix(c.1), mix(c.2)]
+}
+
+fn count(png: &[u8], rgb: [u8; 3]) -> usize {
+    let img = image::load_from_memory(png).expect("valid png").to_rgb8();
+    img.pixels()
+        .filter(|p| p.0.iter().zip(rgb).all(|(a, b)| a.abs_diff(b) <= 1))
+        .count()
+}
+
+/// Grouped bars in a grid beside a top view with faint dots: the grid has its cells' size,
+/// series with values leave bars of their (85 % opaque) colour, a series without values
+/// leaves none (only its legend swatch, fully opaque), and the dots are there, faded.
+#[test]
+fn grouped_bars_and_dots_in_panels() {
+    let bars = GroupedBars {
+        y_label: "MOTA".into(),
+        groups: vec!["real_1".into(), "synthetic_00".into()],
+        series: vec![
+            ("legs".into(), vec![Some(0.8), Some(-0.4)]),
+            ("nearest".into(), vec![Some(0.5), None]),
+            ("absent".into(), vec![None, None]),
+        ],
+        labels: vec![vec!["0.80".into(), "-0.40".into()]],
+        group_notes: vec![String::new(), "one SKIPPED".into()],
+    };
+    let bars = Figure::new("bars", "MOTA", FigureKind::GroupedBars(bars));
+    let dots: Vec<(f64, f64)> = (0..400)
+        .map(|i| (f64::from(i % 20) * 0.5, f64::from(i / 20) * 0.5))
+        .collect();
+    let top = Figure {
+        size: (500, 500),
+        ..Figure::new(
+            "top",
+            "returns",
+            FigureKind::TopView(TopView {
+                trajectories: vec![Series::points("returns", dots, 0).with_mark(Mark::Dots)],
+                ..TopView::default()
+            }),
+        )
+    };
+    let grid = Figure::new(
+        "grid",
+        "Grid",
+        FigureKind::Panels(Panels {
+            columns: 2,
+            panels: vec![bars.clone(), top],
+        }),
+    );
+    assert_eq!(grid.size, (800 * 2, 500 + 30));
+    check(&grid);
+    check(&bars);
+    let png = bars.to_png().expect("png");
+    assert!(count(&png, on_white(color(1), 0.85)) > 500);
+    assert!(count(&png, on_white(color(2), 0.85)) > 500);
+    assert_eq!(count(&png, on_white(color(3), 0.85)), 0);
+    assert!(count(&png, on_white(color(3), 1.0)) > 50, "legend swatch");
+    let png = grid.to_png().expect("png");
+    assert!(count(&png, on_white(color(0), 0.45)) >= 300, "faint dots");
+}
