@@ -120,8 +120,8 @@ fn arrays_of_tables_name_the_element() {
     );
     check(
         laser,
-        "max_range_m = 5.0",
-        "max_range_m = -5.0",
+        "max_range_m = 5.0\n",
+        "max_range_m = -5.0\n",
         "params.synthetic.max_range_m",
     );
 }
