@@ -245,7 +245,7 @@ pub fn products(p: &Params, out: &mut Products) -> anyhow::Result<()> {
         t = t.with_precision(c, 3);
     }
     out.tables.push(t.with_note(format!(
-        "Random forest (smartcore; {} trees, depth ≤ 20, 2 features per split, seed {}) on 12 segment features (src/laser/features + range). Real: leg_tracker's training CSVs, positives = segments nearest a label within 0.1 m, negatives = every {}-th segment of the people-free scans; synthetic: every {}-th scan of the synthetic logs, legs within leg radius + 0.1 m, non-legs farther than 0.5 m from every leg within {} m (every {}-th kept). Threshold: best pooled out-of-fold F1. Test groups never appear in their fold's training.",
+        "Random forest (smartcore; {} trees, depth ≤ 20, 2 features per split, seed {}) on 12 segment features (src/laser/features + range). Real: leg_tracker's training CSVs, positives = segments nearest a label within 0.1 m, negatives = every {}-th segment of the people-free scans; synthetic: every {}-th scan of the synthetic logs, legs within leg radius + 0.1 m, non-legs farther than 0.5 m from every leg within {} m (every {}-th kept). Threshold: best pooled out-of-fold F1, where each kept negative counts as the segments it stands for (precision estimated for whole scans, not the thinned sample). Test groups never appear in their fold's training.",
         p.learned.n_trees, p.learned.seed, p.learned.negative_keep_every, p.learned.synthetic_scan_every, p.learned.max_range_m, p.learned.synthetic_negative_keep_every
     )));
     if let (Ok(r), Ok(s)) = (&models[0].1, &models[1].1) {

@@ -21,7 +21,10 @@
 //! straddle training and test. Groups with positives are dealt to the folds round-robin in
 //! name order, then the negative-only groups. The probability threshold is the one of
 //! `0.05, 0.10, …, 0.95` with the best F1 on the pooled out-of-fold probabilities (ties: the
-//! lower): chosen on the training data, never on the test logs. The final model is trained on
+//! lower): chosen on the training data, never on the test logs. Precision (and so F1) counts
+//! each kept negative as the `negative_keep_every` segments it was drawn from, so it
+//! estimates precision on whole scans rather than on the thinned sample (the first version
+//! counted each once, which put the threshold at 0.40 and let clutter through: see README). The final model is trained on
 //! all samples.
 //!
 //! Training runs sequentially (no rayon inside): sessions wait on one lock while the first one
@@ -287,21 +290,31 @@ pub fn assign_folds(samples: &[Sample], folds: usize) -> BTreeMap<String, usize>
     out
 }
 
-fn score(fold: String, groups: Vec<String>, p: &[f64], y: &[bool], threshold: f64) -> FoldScore {
-    let (mut tp, mut fp, mut fnn) = (0usize, 0usize, 0usize);
+/// Precision and recall of `p >= threshold` against `y`; each negative counts
+/// `negative_weight` times (the under-sampling factor of the negatives: precision is then an
+/// estimate for the scans the negatives were drawn from, not for the thinned sample).
+fn score(
+    fold: String,
+    groups: Vec<String>,
+    p: &[f64],
+    y: &[bool],
+    threshold: f64,
+    negative_weight: f64,
+) -> FoldScore {
+    let (mut tp, mut fp, mut fnn) = (0.0f64, 0.0f64, 0.0f64);
     for (pi, yi) in p.iter().zip(y) {
         match (*pi >= threshold, *yi) {
-            (true, true) => tp += 1,
-            (true, false) => fp += 1,
-            (false, true) => fnn += 1,
+            (true, true) => tp += 1.0,
+            (true, false) => fp += negative_weight,
+            (false, true) => fnn += 1.0,
             _ => {}
         }
     }
-    let ratio = |a: usize, b: usize| {
-        if a + b == 0 {
+    let ratio = |a: f64, b: f64| {
+        if a + b == 0.0 {
             f64::NAN
         } else {
-            a as f64 / (a + b) as f64
+            a / (a + b)
         }
     };
     let (precision, recall) = (ratio(tp, fp), ratio(tp, fnn));
@@ -314,6 +327,15 @@ fn score(fold: String, groups: Vec<String>, p: &[f64], y: &[bool], threshold: f6
         recall,
         f1: 2.0 * precision * recall / (precision + recall),
     }
+}
+
+/// How many segments of the people-free scans each kept negative stands for.
+fn negative_weight(source: Source, p: &LearnedParams) -> f64 {
+    let every = match source {
+        Source::Real => p.negative_keep_every,
+        Source::Synthetic => p.synthetic_negative_keep_every,
+    };
+    every.max(1) as f64
 }
 
 /// Train with grouped cross-validation; the threshold from the out-of-fold probabilities.
@@ -344,9 +366,10 @@ pub fn train(source: Source, set: TrainingSet, p: &LearnedParams) -> anyhow::Res
         }
     }
     let y: Vec<bool> = samples.iter().map(|s| s.leg).collect();
+    let w = negative_weight(source, p);
     let threshold = (1..20)
         .map(|i| f64::from(i) * 0.05)
-        .map(|t| (t, score(String::new(), vec![], &oof, &y, t).f1))
+        .map(|t| (t, score(String::new(), vec![], &oof, &y, t, w).f1))
         .fold((0.5, f64::NEG_INFINITY), |best, (t, f)| {
             if f > best.1 { (t, f) } else { best }
         })
@@ -369,6 +392,7 @@ pub fn train(source: Source, set: TrainingSet, p: &LearnedParams) -> anyhow::Res
             &pf,
             &yf,
             threshold,
+            w,
         ));
     }
     cv.push(score(
@@ -377,6 +401,7 @@ pub fn train(source: Source, set: TrainingSet, p: &LearnedParams) -> anyhow::Res
         &oof,
         &y,
         threshold,
+        w,
     ));
     let (x, _): (Vec<Vec<f64>>, Vec<()>) = samples.iter().map(|s| (s.features.clone(), ())).unzip();
     let forest = Forest::fit(&x, &y, forest_params)?;
@@ -510,10 +535,17 @@ mod tests {
     fn fold_score_counts() {
         let p = [0.9, 0.8, 0.2, 0.6, 0.1];
         let y = [true, true, true, false, false];
-        let sc = score("x".into(), vec![], &p, &y, 0.5);
+        let sc = score("x".into(), vec![], &p, &y, 0.5, 1.0);
         assert_eq!((sc.positives, sc.negatives), (3, 2));
         assert!((sc.precision - 2.0 / 3.0).abs() < 1e-12);
         assert!((sc.recall - 2.0 / 3.0).abs() < 1e-12);
         assert!((sc.f1 - 2.0 / 3.0).abs() < 1e-12);
+        // each negative standing for 10: tp 2, fp 10 → precision 2/12, recall unchanged
+        let sc = score("x".into(), vec![], &p, &y, 0.5, 10.0);
+        assert_eq!((sc.positives, sc.negatives), (3, 2));
+        assert!((sc.precision - 2.0 / 12.0).abs() < 1e-12);
+        assert!((sc.recall - 2.0 / 3.0).abs() < 1e-12);
+        let f1 = 2.0 * (2.0 / 12.0) * (2.0 / 3.0) / (2.0 / 12.0 + 2.0 / 3.0);
+        assert!((sc.f1 - f1).abs() < 1e-12);
     }
 }
