@@ -434,7 +434,10 @@ fn tracks_go_back_into_a_copy_of_the_log_as_markers() {
                     assert_eq!(ids, [id]);
                     let c = centre(0, i);
                     let p = spheres[0].pose.position;
-                    assert!((p.x - c[0]).hypot(p.y - c[1]) < 1e-3, "{method} scan {i}: {p}");
+                    assert!(
+                        (p.x - c[0]).hypot(p.y - c[1]) < 1e-3,
+                        "{method} scan {i}: {p}"
+                    );
                 }
                 // legs: exactly the rows of the tracks CSV on this scan
                 None => {

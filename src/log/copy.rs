@@ -54,12 +54,9 @@ pub fn copy_with_messages<T: RosMessage>(
                 "added messages are not in log-time order ({last} s, then {t} s)"
             )));
         }
-        let ch = *new.get(k).ok_or_else(|| {
-            bad(format!(
-                "added message names topic {k} of {}",
-                topics.len()
-            ))
-        })?;
+        let ch = *new
+            .get(k)
+            .ok_or_else(|| bad(format!("added message names topic {k} of {}", topics.len())))?;
         last = t;
         count += 1;
         w.write(ch, t, &msg)
@@ -145,11 +142,14 @@ mod tests {
                 (m.channel.topic.clone(), m.log_time.0)
             })
             .collect();
-        let want = [("/a", 5), ("/raw", 10), ("/b", 20), ("/raw", 20), ("/a", 30)];
-        assert_eq!(
-            order,
-            want.map(|(t, n)| (t.to_string(), n as u64)).to_vec()
-        );
+        let want = [
+            ("/a", 5),
+            ("/raw", 10),
+            ("/b", 20),
+            ("/raw", 20),
+            ("/a", 30),
+        ];
+        assert_eq!(order, want.map(|(t, n)| (t.to_string(), n as u64)).to_vec());
         let ids: Vec<i32> = read_topic::<MarkerArray>(&log, "/a")
             .expect("read /a")
             .map(|r| r.expect("decodes").1.markers[0].id)

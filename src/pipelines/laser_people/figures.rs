@@ -54,6 +54,9 @@ pub(super) fn all(
 /// A laser pose `(x, y, yaw)` in the fixed frame by scan.
 type Poses = BTreeMap<i64, (f64, f64, f64)>;
 
+/// One track id and its path (fixed frame, m).
+type IdPath = (i64, Vec<(f64, f64)>);
+
 fn to_fixed(poses: &Poses, idx: i64, x: f64, y: f64) -> (f64, f64) {
     match poses.get(&idx) {
         Some(&(px, py, yaw)) => {
@@ -116,12 +119,16 @@ fn top_view(p: &Params, d: &SessionData, poses: &[PoseRow], points: &[PointRow])
         .filter(|&i| seq.scores_scan(i))
         .collect();
     let mut sensors = Vec::new();
-    for (k, idx) in [window.first(), window.last()].into_iter().flatten().enumerate() {
+    for (k, idx) in [window.first(), window.last()]
+        .into_iter()
+        .flatten()
+        .enumerate()
+    {
         if k == 1 && window.len() == 1 {
             break;
         }
         let (x, y, yaw) = pose.get(idx).copied().unwrap_or((0.0, 0.0, 0.0));
-        if k == 1 && pose.get(idx).is_none() {
+        if k == 1 && !pose.contains_key(idx) {
             break; // no TF: the laser is the origin on every scan
         }
         sensors.push(Sensor {
@@ -131,7 +138,7 @@ fn top_view(p: &Params, d: &SessionData, poses: &[PoseRow], points: &[PointRow])
             label: format!("laser, scan {idx}"),
         });
     }
-    let methods: Vec<(&str, Vec<(i64, Vec<(f64, f64)>)>)> = p
+    let methods: Vec<(&str, Vec<IdPath>)> = p
         .methods
         .iter()
         .map(|m| {
@@ -182,7 +189,7 @@ fn top_view(p: &Params, d: &SessionData, poses: &[PoseRow], points: &[PointRow])
             Figure {
                 size: (560, 580),
                 ..Figure::new(
-                    format!("{name}"),
+                    name.to_string(),
                     format!("{name}: {ids} track id{}", if ids == 1 { "" } else { "s" }),
                     FigureKind::TopView(TopView {
                         sensors: sensors.clone(),
@@ -218,12 +225,14 @@ fn top_view(p: &Params, d: &SessionData, poses: &[PoseRow], points: &[PointRow])
 /// The returns within [`MARGIN_M`] of the box around `near` (all of them without `near`),
 /// thinned to at most [`MAX_DOTS`].
 fn returns_near(points: &[PointRow], near: &[(f64, f64)]) -> Vec<(f64, f64)> {
-    let bounds = near.iter().fold(None, |b: Option<(f64, f64, f64, f64)>, &(x, y)| {
-        Some(match b {
-            None => (x, x, y, y),
-            Some((x0, x1, y0, y1)) => (x0.min(x), x1.max(x), y0.min(y), y1.max(y)),
-        })
-    });
+    let bounds = near
+        .iter()
+        .fold(None, |b: Option<(f64, f64, f64, f64)>, &(x, y)| {
+            Some(match b {
+                None => (x, x, y, y),
+                Some((x0, x1, y0, y1)) => (x0.min(x), x1.max(x), y0.min(y), y1.max(y)),
+            })
+        });
     let inside: Vec<(f64, f64)> = points
         .iter()
         .map(|r| (r.x, r.y))
@@ -258,7 +267,11 @@ fn scores(p: &Params, results: &[ResultRow]) -> Figure {
                 .methods
                 .iter()
                 .all(|m| get(g, m.name()).is_none_or(|r| r.status.starts_with("SKIPPED")));
-            if skipped { "SKIPPED".into() } else { String::new() }
+            if skipped {
+                "SKIPPED".into()
+            } else {
+                String::new()
+            }
         })
         .collect();
     let panel = |y_label: &str, title: String, value: &dyn Fn(&ResultRow) -> Option<f64>| {
@@ -345,7 +358,10 @@ mod tests {
     fn laser_frame_positions_go_to_the_fixed_frame() {
         let poses = Poses::from([(3, (1.0, 2.0, std::f64::consts::FRAC_PI_2))]);
         let (x, y) = to_fixed(&poses, 3, 1.0, 0.0);
-        assert!((x - 1.0).abs() < 1e-12 && (y - 3.0).abs() < 1e-12, "{x} {y}");
+        assert!(
+            (x - 1.0).abs() < 1e-12 && (y - 3.0).abs() < 1e-12,
+            "{x} {y}"
+        );
         assert_eq!(to_fixed(&poses, 4, 1.0, 0.0), (1.0, 0.0));
     }
 }

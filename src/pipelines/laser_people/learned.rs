@@ -311,11 +311,7 @@ fn score(
         }
     }
     let ratio = |a: f64, b: f64| {
-        if a + b == 0.0 {
-            f64::NAN
-        } else {
-            a / (a + b)
-        }
+        if a + b == 0.0 { f64::NAN } else { a / (a + b) }
     };
     let (precision, recall) = (ratio(tp, fp), ratio(tp, fnn));
     FoldScore {

@@ -34,7 +34,9 @@ use crate::frames::laser::LaserFrame;
 use crate::laser::legs::{self, Detections, LegParams};
 use crate::laser::points::{self, ScanGeometry, ScanPoint};
 use crate::laser::segment::{self, Segment, SegmentOptions};
-use crate::laser::tracker::{Association, JpdaParams, LEG_ONLY_SCANS, PeopleTracker, TrackerParams};
+use crate::laser::tracker::{
+    Association, JpdaParams, LEG_ONLY_SCANS, PeopleTracker, TrackerParams,
+};
 
 /// A detection + tracking method, by its name in the pipeline file and the tables.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
@@ -64,9 +66,15 @@ impl Method {
     /// One sentence for the results table's note.
     pub fn describe(self) -> &'static str {
         match self {
-            Method::Legs => "seed 002 leg model + PeopleTracker (CV Kalman, GNN, M-of-N; confirmed tracks)",
-            Method::LegsJpda => "seed 002 leg model + PeopleTracker with JPDA (P_D, clutter density at their synthetic-data defaults)",
-            Method::LegsLegLimit => "legs, single legs carry a track at most 20 scans after its last leg pair (chosen on synthetic data)",
+            Method::Legs => {
+                "seed 002 leg model + PeopleTracker (CV Kalman, GNN, M-of-N; confirmed tracks)"
+            }
+            Method::LegsJpda => {
+                "seed 002 leg model + PeopleTracker with JPDA (P_D, clutter density at their synthetic-data defaults)"
+            }
+            Method::LegsLegLimit => {
+                "legs, single legs carry a track at most 20 scans after its last leg pair (chosen on synthetic data)"
+            }
             Method::Nearest => {
                 "midpoint of the two legs nearest to the laser, no filter, one id (the baseline)"
             }

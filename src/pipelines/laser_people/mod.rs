@@ -16,8 +16,8 @@
 
 mod aggregate;
 mod classifier;
-pub mod learned;
 mod figures;
+pub mod learned;
 mod markers;
 mod methods;
 mod params;

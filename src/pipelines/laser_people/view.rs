@@ -88,7 +88,7 @@ impl Collector {
         }
         let k = self.seen;
         self.seen += 1;
-        if k % self.stride.max(1) != 0 {
+        if !k.is_multiple_of(self.stride.max(1)) {
             return;
         }
         let rows = points
