@@ -7,34 +7,19 @@
 //! Set `PEOPLETRACK_KEEP_HOSTILE=DIR` to keep the crafted files (to measure `cat` with
 //! `/usr/bin/time -v`).
 
+#[path = "support/counting_alloc.rs"]
+mod counting_alloc;
+
 mod common;
 
-use std::alloc::{GlobalAlloc, Layout, System};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+use std::sync::atomic::Ordering::Relaxed;
+
+use counting_alloc::{CURRENT, Counting, PEAK};
 
 use common::raw_mcap as raw;
 use peopletrack::log::{Decoders, SessionLog};
-
-struct Counting;
-static CURRENT: AtomicUsize = AtomicUsize::new(0);
-static PEAK: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let p = unsafe { System.alloc(layout) };
-        if !p.is_null() {
-            let now = CURRENT.fetch_add(layout.size(), Relaxed) + layout.size();
-            PEAK.fetch_max(now, Relaxed);
-        }
-        p
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) };
-        CURRENT.fetch_sub(layout.size(), Relaxed);
-    }
-}
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;

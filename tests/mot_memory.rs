@@ -6,29 +6,14 @@
 //! metric, per row, with 100 people per frame stays within a small budget, and does not grow
 //! with the number of people per frame.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+#[path = "support/counting_alloc.rs"]
+mod counting_alloc;
+
+use std::sync::atomic::Ordering::Relaxed;
+
+use counting_alloc::{CURRENT, Counting, PEAK};
 
 use peopletrack::eval::mot::{BoxPx, Geometry, MatchRule, Observation, Sequence};
-
-struct Counting;
-static CURRENT: AtomicUsize = AtomicUsize::new(0);
-static PEAK: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let p = unsafe { System.alloc(layout) };
-        if !p.is_null() {
-            let now = CURRENT.fetch_add(layout.size(), Relaxed) + layout.size();
-            PEAK.fetch_max(now, Relaxed);
-        }
-        p
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) };
-        CURRENT.fetch_sub(layout.size(), Relaxed);
-    }
-}
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
