@@ -23,6 +23,22 @@ use crate::table_row;
 /// Range interval (m) of the feature comparison, in 0.5 m bins.
 pub const RANGE_BINS_M: (f64, f64) = (0.5, 5.0);
 
+/// A figure feature's axis label with its unit.
+fn axis_label(feature: &str) -> String {
+    let unit = match feature {
+        "points" => "returns",
+        "width" | "std_dev" | "radius" => "m",
+        "circularity" => "m²",
+        "mean_curvature" => "1/m",
+        _ => "",
+    };
+    if unit.is_empty() {
+        feature.to_string()
+    } else {
+        format!("{feature} ({unit})")
+    }
+}
+
 /// The features compared in figures.
 pub const FIGURE_FEATURES: [&str; 6] = [
     "points",
@@ -202,7 +218,7 @@ fn figures(real: &[Sample], syn: &[Sample]) -> Vec<Figure> {
                     RANGE_BINS_M.0, RANGE_BINS_M.1
                 ),
                 FigureKind::Lines(LinePlot {
-                    x_label: (*f).to_string(),
+                    x_label: axis_label(f),
                     y_label: "density".into(),
                     series: vec![
                         Series::line(
