@@ -63,12 +63,7 @@ fn decode(log: &SessionLog, topic: &str) -> Vec<LaserFrame> {
 /// The `legs` / `legs_jpda` per-scan work on one scan; returns the confirmed tracks.
 fn detect_track(tracker: &mut PeopleTracker, f: &LaserFrame, t0: u64) -> usize {
     let s = &f.scan;
-    let g = ScanGeometry {
-        angle_min: f64::from(s.angle_min),
-        angle_increment: f64::from(s.angle_increment),
-        range_min: f64::from(s.range_min),
-        range_max: f64::from(s.range_max),
-    };
+    let g = ScanGeometry::of(s);
     let pose = f.pose.as_ref();
     let pts = points::project(&s.ranges, &g, pose);
     let segs = segment::segment(&pts, &SegmentOptions::default());

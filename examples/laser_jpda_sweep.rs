@@ -51,12 +51,7 @@ fn load(path: &str) -> Res<Vec<Scan>> {
         let f = f?;
         let Some(pose) = f.pose else { continue };
         let s = &f.scan;
-        let g = ScanGeometry {
-            angle_min: f64::from(s.angle_min),
-            angle_increment: f64::from(s.angle_increment),
-            range_min: f64::from(s.range_min),
-            range_max: f64::from(s.range_max),
-        };
+        let g = ScanGeometry::of(s);
         let pts = points::project(&s.ranges, &g, Some(&pose));
         let segs = segment::segment(&pts, &SegmentOptions::default());
         let d = legs::detect(

@@ -18,8 +18,9 @@
 //! [`training`] builds labelled segment samples for a learned leg detector (leg_tracker's
 //! training CSVs, parsed from text; synthetic ground-truth legs).
 //!
-//! No file I/O and no `log`/`frames` imports: a pipeline turns a
-//! `frames::laser::LaserFrame` into [`points::ScanGeometry`] + ranges + pose. Nothing here
+//! No file I/O and no `frames` imports; of `log` only the decoded `LaserScan` message type
+//! ([`points::ScanGeometry::of`]): a pipeline turns a `frames::laser::LaserFrame` into
+//! [`points::ScanGeometry`] + ranges + pose. Nothing here
 //! panics on NaN or infinite input.
 
 pub mod circle;

@@ -12,6 +12,8 @@
 
 use nalgebra::{Isometry3, Point2, Point3};
 
+use crate::log::msgs::LaserScan;
+
 /// The beam geometry of a scan (the `sensor_msgs/LaserScan` fields that place beams).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScanGeometry {
@@ -22,6 +24,16 @@ pub struct ScanGeometry {
 }
 
 impl ScanGeometry {
+    /// The beam geometry of a decoded `sensor_msgs/LaserScan`.
+    pub fn of(scan: &LaserScan) -> Self {
+        ScanGeometry {
+            angle_min: f64::from(scan.angle_min),
+            angle_increment: f64::from(scan.angle_increment),
+            range_min: f64::from(scan.range_min),
+            range_max: f64::from(scan.range_max),
+        }
+    }
+
     /// Bearing of beam `k` (rad).
     pub fn angle(&self, k: usize) -> f64 {
         self.angle_min + k as f64 * self.angle_increment

@@ -535,12 +535,7 @@ fn detection_and_tracking_run_over_a_real_log() {
     for f in frames.by_ref().take(200) {
         let f = f.expect("scan");
         let s = &f.scan;
-        let g = ScanGeometry {
-            angle_min: f64::from(s.angle_min),
-            angle_increment: f64::from(s.angle_increment),
-            range_min: f64::from(s.range_min),
-            range_max: f64::from(s.range_max),
-        };
+        let g = ScanGeometry::of(s);
         let pts = points::project(&s.ranges, &g, f.pose.as_ref());
         let segs = segment::segment(&pts, &SegmentOptions::default());
         let d = legs::detect(

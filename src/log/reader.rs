@@ -76,17 +76,25 @@ pub struct SessionLog {
     summary: LogSummary,
 }
 
+/// The file at `path`, its length, and the read position after its MCAP magic (else
+/// [`LogErrorKind::NotMcap`]).
+fn open_mcap(path: &Path) -> Result<(PathBuf, File, u64), LogError> {
+    let path = path.to_path_buf();
+    let err = |k: LogErrorKind| LogError::new(&path, k);
+    let mut file = File::open(&path).map_err(|e| err(e.into()))?;
+    let file_len = file.metadata().map_err(|e| err(e.into()))?.len();
+    let mut magic = [0u8; 8];
+    if file_len < 8 || file.read_exact(&mut magic).is_err() || &magic != records::MAGIC {
+        return Err(err(LogErrorKind::NotMcap));
+    }
+    Ok((path, file, file_len))
+}
+
 impl SessionLog {
     /// Open a log and read its index (summary section, or one linear pass without one).
     pub fn open(path: impl AsRef<Path>) -> Result<SessionLog, LogError> {
-        let path = path.as_ref().to_path_buf();
+        let (path, mut file, file_len) = open_mcap(path.as_ref())?;
         let err = |k: LogErrorKind| LogError::new(&path, k);
-        let mut file = File::open(&path).map_err(|e| err(e.into()))?;
-        let file_len = file.metadata().map_err(|e| err(e.into()))?.len();
-        let mut magic = [0u8; 8];
-        if file_len < 8 || file.read_exact(&mut magic).is_err() || &magic != records::MAGIC {
-            return Err(err(LogErrorKind::NotMcap));
-        }
         let summary = match index::read_summary_section(&mut file, file_len).map_err(err)? {
             Some(s) if index::summary_is_complete(&s) => s,
             Some(claimed) => {
@@ -113,14 +121,8 @@ impl SessionLog {
     /// was lost is said in [`LogSummary::warnings`]; the messages read are the complete ones
     /// before the damage (and in any good chunk after a bad one).
     pub fn open_recovering(path: impl AsRef<Path>) -> Result<SessionLog, LogError> {
-        let path = path.as_ref().to_path_buf();
+        let (path, mut file, file_len) = open_mcap(path.as_ref())?;
         let err = |k: LogErrorKind| LogError::new(&path, k);
-        let mut file = File::open(&path).map_err(|e| err(e.into()))?;
-        let file_len = file.metadata().map_err(|e| err(e.into()))?.len();
-        let mut magic = [0u8; 8];
-        if file_len < 8 || file.read_exact(&mut magic).is_err() || &magic != records::MAGIC {
-            return Err(err(LogErrorKind::NotMcap));
-        }
         let summary = index::recovering_index(&mut file, file_len).map_err(err)?;
         Ok(SessionLog { path, summary })
     }

@@ -153,6 +153,23 @@ impl Writer {
         }
     }
 
+    /// A packed array of `N`-byte numbers, aligned to `N` when not empty.
+    fn put_packed<T: Copy, const N: usize>(
+        &mut self,
+        xs: &[T],
+        be: fn(T) -> [u8; N],
+        le: fn(T) -> [u8; N],
+    ) {
+        if !xs.is_empty() {
+            self.align(N);
+        }
+        self.buf.reserve(xs.len() * N);
+        let bytes = if self.big { be } else { le };
+        for &x in xs {
+            self.buf.extend_from_slice(&bytes(x));
+        }
+    }
+
     fn write_elements(&mut self, reg: &Registry, ty: &BaseType, v: &Value) -> Result<()> {
         // Fast paths: packed arrays whose variant matches the wire type exactly.
         match (ty, v) {
@@ -161,31 +178,11 @@ impl Writer {
                 return Ok(());
             }
             (BaseType::Prim(Prim::F32), Value::F32s(xs)) => {
-                if !xs.is_empty() {
-                    self.align(4);
-                }
-                self.buf.reserve(xs.len() * 4);
-                for x in xs {
-                    if self.big {
-                        self.buf.extend_from_slice(&x.to_be_bytes());
-                    } else {
-                        self.buf.extend_from_slice(&x.to_le_bytes());
-                    }
-                }
+                self.put_packed(xs, f32::to_be_bytes, f32::to_le_bytes);
                 return Ok(());
             }
             (BaseType::Prim(Prim::F64), Value::F64s(xs)) => {
-                if !xs.is_empty() {
-                    self.align(8);
-                }
-                self.buf.reserve(xs.len() * 8);
-                for x in xs {
-                    if self.big {
-                        self.buf.extend_from_slice(&x.to_be_bytes());
-                    } else {
-                        self.buf.extend_from_slice(&x.to_le_bytes());
-                    }
-                }
+                self.put_packed(xs, f64::to_be_bytes, f64::to_le_bytes);
                 return Ok(());
             }
             _ => {}

@@ -222,12 +222,7 @@ pub fn synthetic_samples(
             else {
                 continue;
             };
-            let geometry = ScanGeometry {
-                angle_min: f64::from(f.scan.angle_min),
-                angle_increment: f64::from(f.scan.angle_increment),
-                range_min: f64::from(f.scan.range_min),
-                range_max: f64::from(f.scan.range_max),
-            };
+            let geometry = ScanGeometry::of(&f.scan);
             let s = training::segment_scan(&f.scan.ranges, &geometry);
             let legs: Vec<(Point2<f64>, f64)> = gt
                 .people

@@ -112,12 +112,7 @@ pub struct ScanView<'a> {
 
 impl<'a> ScanView<'a> {
     pub fn new(frame: &'a LaserFrame) -> Self {
-        let g = ScanGeometry {
-            angle_min: f64::from(frame.scan.angle_min),
-            angle_increment: f64::from(frame.scan.angle_increment),
-            range_min: f64::from(frame.scan.range_min),
-            range_max: f64::from(frame.scan.range_max),
-        };
+        let g = ScanGeometry::of(&frame.scan);
         let points = points::project(&frame.scan.ranges, &g, frame.pose.as_ref());
         let segments = segment::segment(&points, &SegmentOptions::default());
         let geometric = legs::detect(

@@ -360,14 +360,7 @@ impl Figure {
             .disable_x_mesh()
             .y_desc(&p.y_label)
             .x_labels(n)
-            .x_label_formatter(&|x| {
-                let i = x.round();
-                if (x - i).abs() < 1e-6 && i >= 0.0 {
-                    labels.get(i as usize).cloned().unwrap_or_default()
-                } else {
-                    String::new()
-                }
-            })
+            .x_label_formatter(&|x| label_at(&labels, *x))
             .label_style(("sans-serif", 13))
             .draw()?;
         for (i, b) in p.bars.iter().enumerate() {
@@ -549,4 +542,14 @@ pub fn least_squares(pts: &[(f64, f64)]) -> Option<(f64, f64)> {
     let sxy: f64 = pts.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
     let b = sxy / sxx;
     Some((my - b * mx, b))
+}
+
+/// The label of category `x` on a category axis (`0, 1, …`); empty between categories.
+pub(super) fn label_at(labels: &[String], x: f64) -> String {
+    let i = x.round();
+    if (x - i).abs() < 1e-6 && i >= 0.0 {
+        labels.get(i as usize).cloned().unwrap_or_default()
+    } else {
+        String::new()
+    }
 }

@@ -4,7 +4,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::draw::{DrawResult, caption_style};
+use super::draw::{DrawResult, caption_style, label_at};
 use super::spec::{Figure, GroupedBars, Panels, color};
 
 /// Share of a group's width covered by its bars.
@@ -46,14 +46,7 @@ impl Figure {
             .disable_x_mesh()
             .y_desc(&p.y_label)
             .x_labels(n)
-            .x_label_formatter(&|x| {
-                let i = x.round();
-                if (x - i).abs() < 1e-6 && i >= 0.0 {
-                    groups.get(i as usize).cloned().unwrap_or_default()
-                } else {
-                    String::new()
-                }
-            })
+            .x_label_formatter(&|x| label_at(&groups, *x))
             .y_label_formatter(&|v| format!("{}", (v * 1000.0).round() / 1000.0 + 0.0))
             .light_line_style(RGBColor(246, 246, 246))
             .label_style(("sans-serif", 12))
