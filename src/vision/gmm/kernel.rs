@@ -9,7 +9,21 @@
 //! every instruction set).
 //!
 //! The kernel is written once against [`Simd`]; [`Portable`] implements it with arrays
-//! (any CPU), `Avx2` with AVX2 intrinsics (chosen at run time).
+//! (any CPU), `Avx2` with `std::arch` AVX2 intrinsics, chosen at run time
+//! ([`Isa::detect`]). Hand-written rather than the `wide` crate: `wide` picks its backend
+//! at compile time from the enabled target features, so the default x86-64 build (no
+//! `-C target-cpu`) would run 4-lane SSE code, while run-time detection gives one binary
+//! that uses 8 lanes wherever AVX2 exists and stays correct elsewhere. Neither side uses
+//! fused multiply-adds (Rust never contracts `a * b + c`, and the intrinsics are plain
+//! `mul`/`add`), which is what keeps every lane equal to OpenCV's scalar code.
+//!
+//! Two things keep the AVX2 path fast. The row functions carry
+//! `#[target_feature(enable = "avx2")]` and every [`Simd`] method is `#[inline(always)]`, so
+//! the intrinsics inline into them; a closure (`std::array::from_fn(|c| ..)`, `map`) is a
+//! function of its own compiled *without* AVX2, into which the intrinsics cannot inline, so
+//! the kernel uses plain loops (one closure in `load_pixels` once made the whole update
+//! several times slower). And the state is a [`LaneBuf`], whose vectors start on cache-line
+//! boundaries.
 //!
 //! State layout ([`Layout`]): each image row is `groups = ceil(width / LANES)` groups of
 //! pixels; within a row, component slot k of every group comes before slot k + 1
@@ -18,7 +32,7 @@
 //! and slots no pixel uses are never touched. Lanes past the right edge of the image compute
 //! on zeros and are never read back.
 
-pub(super) use simd::{LANES, Lanes};
+pub(super) use simd::{LANES, LaneBuf, Lanes};
 use simd::{Portable, Simd};
 
 #[cfg(target_arch = "x86_64")]
@@ -194,7 +208,11 @@ fn update_group<S: Simd, const C: usize>(
         let mut owner = s.none();
         if s.bits(open) != 0 {
             let var = grp.get(s, k, 1);
-            let d: [S::F; C] = std::array::from_fn(|c| s.sub(grp.get(s, k, 2 + c), x[c]));
+            // Loops, not closures (see `Avx2::load_pixels`).
+            let mut d = [zero; C];
+            for (c, dc) in d.iter_mut().enumerate() {
+                *dc = s.sub(grp.get(s, k, 2 + c), x[c]);
+            }
             let mut dist2 = s.mul(d[0], d[0]);
             for dc in d.iter().skip(1) {
                 dist2 = s.add(dist2, s.mul(*dc, *dc));
@@ -328,7 +346,10 @@ fn detect_shadow<S: Simd, const C: usize>(
         if s.bits(live) == 0 {
             break;
         }
-        let mean: [S::F; C] = std::array::from_fn(|c| grp.get(s, k, 2 + c));
+        let mut mean = [zero; C];
+        for (c, m) in mean.iter_mut().enumerate() {
+            *m = grp.get(s, k, 2 + c);
+        }
         let mut num = s.mul(x[0], mean[0]);
         let mut den = s.mul(mean[0], mean[0]);
         for c in 1..C {

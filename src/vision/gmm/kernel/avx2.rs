@@ -99,45 +99,38 @@ impl Simd for Avx2 {
     }
     #[inline(always)]
     fn load_pixels<const C: usize>(self, src: &[u8]) -> [__m256; C] {
+        // No closures here: a closure is a function of its own, compiled without AVX2, so
+        // the intrinsics inside it would not inline into the AVX2 row.
         let src = &src[..LANES * C];
+        let mut out = [self.none(); C];
         if C == 3 {
             // 24 bytes: pshufb channel c's bytes (c, c+3, .., c+21) to the bottom of a
             // 16-byte register from the two halves, OR them, widen to i32 and convert.
-            let mut lo = [0u8; 16];
-            let mut hi = [0u8; 16];
-            lo.copy_from_slice(&src[..16]);
-            hi[..8].copy_from_slice(&src[16..24]);
+            const LO: [[i8; 16]; 3] = shuffle_lo();
+            const HI: [[i8; 16]; 3] = shuffle_hi();
             unsafe {
-                let lo = _mm_loadu_si128(lo.as_ptr().cast());
-                let hi = _mm_loadu_si128(hi.as_ptr().cast());
-                std::array::from_fn(|c| {
-                    let (mut a, mut b) = ([-1i8; 16], [-1i8; 16]);
-                    for l in 0..LANES {
-                        let i = l * 3 + c;
-                        if i < 16 {
-                            a[l] = i as i8;
-                        } else {
-                            b[l] = (i - 16) as i8;
-                        }
-                    }
-                    let a = _mm_loadu_si128(a.as_ptr().cast());
-                    let b = _mm_loadu_si128(b.as_ptr().cast());
+                let lo = _mm_loadu_si128(src.as_ptr().cast());
+                let hi = _mm_loadl_epi64(src[16..].as_ptr().cast());
+                for (c, o) in out.iter_mut().enumerate() {
+                    let a = _mm_loadu_si128(LO[c].as_ptr().cast());
+                    let b = _mm_loadu_si128(HI[c].as_ptr().cast());
                     let v = _mm_or_si128(_mm_shuffle_epi8(lo, a), _mm_shuffle_epi8(hi, b));
-                    _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(v))
-                })
+                    *o = _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(v));
+                }
             }
         } else {
-            std::array::from_fn(|c| {
+            for (c, o) in out.iter_mut().enumerate() {
                 let mut b = [0u8; 16];
                 for l in 0..LANES {
                     b[l] = src[l * C + c];
                 }
                 unsafe {
                     let v = _mm_loadu_si128(b.as_ptr().cast());
-                    _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(v))
+                    *o = _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(v));
                 }
-            })
+            }
         }
+        out
     }
     #[inline(always)]
     fn load_counts(self, c: &[u8; LANES]) -> __m256 {
@@ -172,4 +165,31 @@ impl Simd for Avx2 {
         }
         out
     }
+}
+
+/// `pshufb` controls gathering channel c of eight RGB pixels from bytes 0..16 (`LO`) and
+/// 16..24 (`HI`) of the row; -1 zeroes a byte.
+const fn shuffle_lo() -> [[i8; 16]; 3] {
+    shuffle(true)
+}
+const fn shuffle_hi() -> [[i8; 16]; 3] {
+    shuffle(false)
+}
+const fn shuffle(low: bool) -> [[i8; 16]; 3] {
+    let mut out = [[-1i8; 16]; 3];
+    let mut c = 0;
+    while c < 3 {
+        let mut l = 0;
+        while l < LANES {
+            let i = l * 3 + c;
+            if low && i < 16 {
+                out[c][l] = i as i8;
+            } else if !low && i >= 16 {
+                out[c][l] = (i - 16) as i8;
+            }
+            l += 1;
+        }
+        c += 1;
+    }
+    out
 }

@@ -7,6 +7,58 @@ pub(in crate::vision::gmm) const LANES: usize = 8;
 /// One lane vector of state.
 pub(in crate::vision::gmm) type Lanes = [f32; LANES];
 
+/// Bytes of a cache line: [`LaneBuf`] starts its vectors on one.
+const LINE: usize = 64;
+/// Floats of slack a [`LaneBuf`] allocates to move its start to a line boundary.
+const SLACK: usize = LINE / 4 - 1;
+
+/// Lane vectors whose first vector starts on a 64-byte boundary, so that no 32-byte vector
+/// load straddles two cache lines (a `Vec<[f32; 8]>` is only 16-byte aligned in practice).
+/// Stored as floats with a little slack; the vectors are a safe `as_chunks` view of them.
+#[derive(Debug, Default)]
+pub(in crate::vision::gmm) struct LaneBuf {
+    raw: Vec<f32>,
+    len: usize,
+}
+
+impl LaneBuf {
+    /// `len` vectors of zeros.
+    pub fn zeroed(len: usize) -> Self {
+        Self {
+            raw: vec![0.0; len * LANES + SLACK],
+            len,
+        }
+    }
+    fn start(&self) -> usize {
+        // An `f32` pointer can always reach the boundary within 15 floats.
+        self.raw.as_ptr().align_offset(LINE).min(SLACK)
+    }
+    pub fn as_slice(&self) -> &[Lanes] {
+        if self.len == 0 {
+            return &[];
+        }
+        let s = self.start();
+        self.raw[s..s + self.len * LANES].as_chunks::<LANES>().0
+    }
+    pub fn as_mut_slice(&mut self) -> &mut [Lanes] {
+        if self.len == 0 {
+            return &mut [];
+        }
+        let s = self.start();
+        self.raw[s..s + self.len * LANES].as_chunks_mut::<LANES>().0
+    }
+}
+
+/// A derived `Clone` would copy the floats to an allocation whose boundary may fall
+/// elsewhere; copy the vectors instead.
+impl Clone for LaneBuf {
+    fn clone(&self) -> Self {
+        let mut out = Self::zeroed(self.len);
+        out.as_mut_slice().copy_from_slice(self.as_slice());
+        out
+    }
+}
+
 /// Eight-lane `f32` operations. Comparisons are ordered and quiet (false on NaN), like
 /// Rust's `<`; masks are all-ones or all-zeros per lane.
 pub(super) trait Simd: Copy {
