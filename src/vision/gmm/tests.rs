@@ -439,6 +439,10 @@ fn save_load_round_trip_and_corrupt_input() {
     }
     let mut bytes = Vec::new();
     m.save(&mut bytes).expect("save");
+    // A clone holds the same state (its aligned buffer may start at another offset).
+    let mut copy = Vec::new();
+    m.clone().save(&mut copy).expect("save clone");
+    assert_eq!(copy, bytes);
     let mut back = AdaptiveGmm::load(&mut bytes.as_slice()).expect("load");
     let mut again = Vec::new();
     back.save(&mut again).expect("save again");
@@ -469,4 +473,141 @@ fn save_load_round_trip_and_corrupt_input() {
     let back = AdaptiveGmm::load(&mut b.as_slice()).expect("load");
     assert_eq!(back.params(), &GmmParams::stauffer_grimson());
     assert_eq!(back.shape(), None);
+}
+
+/// Run `frames` through the kernel (on `isa`, in a rayon pool of `threads`) and through the
+/// scalar reference; every mask and every component must agree bit for bit. Returns the
+/// kernel's last mask.
+fn check_against_reference(
+    params: GmmParams,
+    (w, h, c): (usize, usize, usize),
+    frames: &[Vec<u8>],
+    lr: Option<f32>,
+    isa: Isa,
+    threads: usize,
+) -> Vec<u8> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool");
+    let mut m = model(params);
+    let mut r = ReferenceGmm::new(params, w * h, c);
+    let (mut got, mut want) = (vec![0u8; w * h], vec![0u8; w * h]);
+    for (t, f) in frames.iter().enumerate() {
+        let view = ImageView::new(f, w, h, c).expect("frame");
+        pool.install(|| m.apply_with(isa, view, lr, &mut got))
+            .expect("apply");
+        r.apply(f, lr, &mut want);
+        assert_eq!(got, want, "{w}x{h}x{c} frame {t} on {threads} threads");
+        assert_same_state(&m, &r, w, t);
+    }
+    got
+}
+
+#[test]
+fn kernel_matches_reference_at_lane_remainder_widths_and_thread_counts() {
+    // Widths around the 8-lane group: 1 (seven padding lanes), 7, 8 (none), 9 (a group of
+    // one), 17; two rows so the rows can go to different threads.
+    for (i, w) in [1usize, 7, 8, 9, 17].into_iter().enumerate() {
+        for c in [1, 3] {
+            let frames = stress_frames(w, 2, c, 60, 100 + i as u64);
+            for isa in Isa::available() {
+                for threads in [1, 2] {
+                    check_against_reference(
+                        GmmParams::default(),
+                        (w, 2, c),
+                        &frames,
+                        None,
+                        isa,
+                        threads,
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn hand_made_lanes_with_different_histories_match_reference_and_known_answers() {
+    // Nine RGB pixels (one full group of eight and a group of one), M = 3; each pixel has
+    // its own story, so within a group the lanes hold different numbers of components and
+    // take different branches in the same frame. α = 0.05 after the first frame makes the
+    // pruning quick: the weight of a component no sample owns follows
+    // π ← 0.95π − 0.0025 (then a renormalisation by about 1.005) and falls below
+    // αc_T = 0.0025 about 60 frames after its last sample.
+    let lr = Some(0.05);
+    let params = GmmParams {
+        n_mixtures: 3,
+        ..GmmParams::default()
+    };
+    let (w, n) = (9, 160);
+    let grey = |v: u8| [v, v, v];
+    let story = |p: usize, t: usize| -> [u8; 3] {
+        match p {
+            // Constant: one component.
+            0 | 8 => grey(90),
+            // Two colours in turn: two components.
+            1 => grey(if t % 2 == 0 { 30 } else { 220 }),
+            // Four colours in turn with room for three: every frame creates a component,
+            // replacing the weakest once the pixel is full.
+            2 => grey([20u8, 80, 150, 240][t % 4]),
+            // One frame of another colour, then constant: that component is dropped.
+            3 => grey(if t == 0 { 250 } else { 40 }),
+            // A background whose last frame is 0.7 times as bright: a shadow.
+            4 => {
+                if t + 1 == n {
+                    [140, 105, 70]
+                } else {
+                    [200, 150, 100]
+                }
+            }
+            // The same background, last frame another hue: foreground.
+            5 => {
+                if t + 1 == n {
+                    [100, 150, 200]
+                } else {
+                    [200, 150, 100]
+                }
+            }
+            // Black: the shadow test's zero denominator.
+            6 => [0, 0, 0],
+            // Black, then white from the middle: a new component takes over, the old one is
+            // dropped.
+            _ => grey(if t < n / 2 { 0 } else { 255 }),
+        }
+    };
+    let frames: Vec<Vec<u8>> = (0..n)
+        .map(|t| (0..w).flat_map(|p| story(p, t)).collect())
+        .collect();
+    for isa in Isa::available() {
+        for threads in [1, 2] {
+            let last = check_against_reference(params, (w, 1, 3), &frames, lr, isa, threads);
+            // Pixel 2: a sample no component owns starts a component with µ = x before the
+            // shadow test (OpenCV's order); the older weights sum to less than 1 − c_f, so
+            // the test reaches it and finds x an undarkened copy (a = 1): "shadow". Pixel 5:
+            // there the background alone weighs 1 − α = 0.95 > 0.9 and the search stops.
+            assert_eq!(
+                last,
+                [
+                    BACKGROUND,
+                    BACKGROUND,
+                    DEFAULT_SHADOW_VALUE,
+                    BACKGROUND,
+                    DEFAULT_SHADOW_VALUE,
+                    FOREGROUND,
+                    BACKGROUND,
+                    BACKGROUND,
+                    BACKGROUND,
+                ]
+            );
+        }
+    }
+    let mut m = model(params);
+    let mut mask = vec![0u8; w];
+    for f in &frames {
+        m.apply(ImageView::new(f, w, 1, 3).expect("frame"), lr, &mut mask)
+            .expect("apply");
+    }
+    // The shadow and the other hue each started a component on the last frame.
+    assert_eq!(m.components_per_pixel(), [1, 2, 3, 1, 2, 2, 1, 1, 1]);
 }
