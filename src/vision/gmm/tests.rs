@@ -547,7 +547,7 @@ fn hand_made_lanes_with_different_histories_match_reference_and_known_answers() 
             // Constant: one component.
             0 | 8 => grey(90),
             // Two colours in turn: two components.
-            1 => grey(if t % 2 == 0 { 30 } else { 220 }),
+            1 => grey(if t.is_multiple_of(2) { 30 } else { 220 }),
             // Four colours in turn with room for three: every frame creates a component,
             // replacing the weakest once the pixel is full.
             2 => grey([20u8, 80, 150, 240][t % 4]),
