@@ -76,6 +76,10 @@ def compare(criterion_dir, opencv_json):
             if threads == 2 and 1 in ours and f"{name}_t1" in cv:
                 scaling = f"{fps / ours[1]:.2f}x / {peer / cv[f'{name}_t1']['fps']:.2f}x"
             print(f"| {work} | {fps:,.0f} | {peer:,.0f} | **{fps / peer:.2f}x** | {scaling} |")
+    load = os.getloadavg()[0]
+    cores = os.cpu_count()
+    note = "" if load < 0.5 * cores else " (busy: the ratios are indicative, the 2-thread scaling is not)"
+    print(f"\nload average over the last minute: {load:.1f} on {cores} cores{note}")
 
 
 if __name__ == "__main__":
