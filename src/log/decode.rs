@@ -21,7 +21,7 @@ use prost_reflect::MessageDescriptor;
 
 use super::cdr;
 use super::error::{LogError, LogErrorKind};
-use super::fast::{Decoded, FastKind, Scratch};
+use super::fast::{self, Decoded, FastKind, Scratch};
 use super::msgs::RosMessage;
 use super::protobuf::{self, FoxgloveMessage};
 use super::reader::{ChannelInfo, Message, SessionLog};
@@ -173,7 +173,7 @@ impl Decoders {
     }
 
     /// Decode a message as the typed `T`, from its ROS 2 type or a Foxglove equivalent.
-    pub fn typed<T: RosMessage + FoxgloveMessage>(
+    pub fn typed<T: RosMessage + FoxgloveMessage + 'static>(
         &mut self,
         log: &SessionLog,
         msg: &Message,
@@ -193,10 +193,10 @@ impl Decoders {
                 found: schema,
             }));
         }
-        if is_ros && self.entry(msg).fast.is_some_and(|k| k.type_name() == T::TYPE_NAME) {
-            if let Some(r) = T::fast_cdr(&msg.data) {
-                return r.map_err(|e| err(e.into()));
-            }
+        if let Some(kind) = self.entry(msg).fast.filter(|_| is_ros)
+            && let Some(r) = fast::decode_as::<T>(kind, &msg.data)
+        {
+            return r.map_err(|e| err(e.into()));
         }
         let v = self.value(log, msg)?;
         let typed = if is_ros {
@@ -209,7 +209,7 @@ impl Decoders {
 }
 
 /// Read every message of `topic` as `T`, in log-time order, as `(log_time, message)`.
-pub fn read_topic<T: RosMessage + FoxgloveMessage>(
+pub fn read_topic<T: RosMessage + FoxgloveMessage + 'static>(
     log: &SessionLog,
     topic: &str,
 ) -> Result<impl Iterator<Item = Result<(Nanos, T), LogError>>, LogError> {

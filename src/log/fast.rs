@@ -21,6 +21,7 @@
 //! Written by hand for the same reason as [`super::cdr`]: the Rust CDR crates need serde types
 //! generated at compile time and would not share the dynamic decoder's bounds and errors.
 
+use std::any::{Any, TypeId};
 use std::borrow::Cow;
 use std::sync::OnceLock;
 
@@ -100,6 +101,29 @@ pub fn decode<T: FastCdr + Default>(data: &[u8]) -> Result<T> {
     let mut out = T::default();
     decode_into(data, &mut out)?;
     Ok(out)
+}
+
+/// Decode a payload of a channel of fast kind `kind` as `T`, when `T` is that kind's typed
+/// message (`None` otherwise). For generic callers that hold a `T: RosMessage`; the concrete
+/// type is recovered by downcasting, so the message types need not know this module.
+pub fn decode_as<T: 'static>(kind: FastKind, data: &[u8]) -> Option<Result<T>> {
+    fn boxed<U: FastCdr + Default + 'static>(data: &[u8]) -> Result<Box<dyn Any>> {
+        decode::<U>(data).map(|u| Box::new(u) as Box<dyn Any>)
+    }
+    let wanted = TypeId::of::<T>();
+    let r = match kind {
+        FastKind::Tf if wanted == TypeId::of::<TfMessage>() => boxed::<TfMessage>(data),
+        FastKind::Odometry if wanted == TypeId::of::<Odometry>() => boxed::<Odometry>(data),
+        FastKind::Imu if wanted == TypeId::of::<Imu>() => boxed::<Imu>(data),
+        FastKind::LaserScan if wanted == TypeId::of::<LaserScan>() => boxed::<LaserScan>(data),
+        FastKind::Image if wanted == TypeId::of::<Image>() => boxed::<Image>(data),
+        FastKind::CompressedImage if wanted == TypeId::of::<CompressedImage>() => {
+            boxed::<CompressedImage>(data)
+        }
+        FastKind::CameraInfo if wanted == TypeId::of::<CameraInfo>() => boxed::<CameraInfo>(data),
+        _ => return None,
+    };
+    Some(r.map(|b| *b.downcast::<T>().expect("the type id was checked")))
 }
 
 /// Decode a whole CDR payload into `out`, reusing its buffers.

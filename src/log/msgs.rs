@@ -20,11 +20,6 @@ pub trait RosMessage: Sized {
     fn from_value(v: Value) -> Result<Self>;
     /// The value tree the CDR encoder writes.
     fn to_value(&self) -> Value;
-    /// Decode a CDR payload by the typed fast path ([`super::fast`]), for the types that have
-    /// one; callers check first that the channel's layout is the canonical one.
-    fn fast_cdr(_data: &[u8]) -> Option<std::result::Result<Self, super::cdr::CdrError>> {
-        None
-    }
 }
 
 /// Take field `name` out of `v` and convert it, adding the field name to any error's path.

@@ -283,3 +283,15 @@ fn reused_buffers_give_the_same_message_as_a_fresh_decode() {
     decode_into(&small.buf, &mut reused).expect("decodes");
     assert_eq!(reused, decode::<TfMessage>(&small.buf).expect("decodes"));
 }
+
+#[test]
+fn decode_as_gives_only_the_kinds_own_type() {
+    let mut w = W::new(false, 8);
+    w.header(1, 2, b"cam").str(b"png").u32(1).u8(9);
+    let c = decode_as::<CompressedImage>(FastKind::CompressedImage, &w.buf)
+        .expect("its own type")
+        .expect("decodes");
+    assert_eq!(c.data, [9]);
+    assert!(decode_as::<Image>(FastKind::CompressedImage, &w.buf).is_none());
+    assert!(decode_as::<String>(FastKind::Tf, &w.buf).is_none());
+}

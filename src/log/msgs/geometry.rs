@@ -99,10 +99,6 @@ pub struct TfMessage {
 impl RosMessage for TfMessage {
     const TYPE_NAME: &'static str = "tf2_msgs/msg/TFMessage";
 
-    fn fast_cdr(data: &[u8]) -> Option<std::result::Result<Self, crate::log::cdr::CdrError>> {
-        Some(crate::log::fast::decode(data))
-    }
-
     fn from_value(mut v: Value) -> Result<Self> {
         Ok(TfMessage {
             transforms: field(&mut v, "transforms", |a| {
@@ -133,10 +129,6 @@ pub struct Odometry {
 
 impl RosMessage for Odometry {
     const TYPE_NAME: &'static str = "nav_msgs/msg/Odometry";
-
-    fn fast_cdr(data: &[u8]) -> Option<std::result::Result<Self, crate::log::cdr::CdrError>> {
-        Some(crate::log::fast::decode(data))
-    }
 
     fn from_value(mut v: Value) -> Result<Self> {
         let header = field(&mut v, "header", Header::from_value)?;

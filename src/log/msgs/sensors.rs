@@ -38,10 +38,6 @@ impl LaserScan {
 impl RosMessage for LaserScan {
     const TYPE_NAME: &'static str = "sensor_msgs/msg/LaserScan";
 
-    fn fast_cdr(data: &[u8]) -> Option<std::result::Result<Self, crate::log::cdr::CdrError>> {
-        Some(crate::log::fast::decode(data))
-    }
-
     fn from_value(mut v: Value) -> Result<Self> {
         let f32_field = |v: &mut Value, n: &str| field(v, n, |x| x.as_f64().map(|f| f as f32));
         Ok(LaserScan {
@@ -89,10 +85,6 @@ pub struct Image {
 impl RosMessage for Image {
     const TYPE_NAME: &'static str = "sensor_msgs/msg/Image";
 
-    fn fast_cdr(data: &[u8]) -> Option<std::result::Result<Self, crate::log::cdr::CdrError>> {
-        Some(crate::log::fast::decode(data))
-    }
-
     fn from_value(mut v: Value) -> Result<Self> {
         Ok(Image {
             header: field(&mut v, "header", Header::from_value)?,
@@ -129,10 +121,6 @@ pub struct CompressedImage {
 
 impl RosMessage for CompressedImage {
     const TYPE_NAME: &'static str = "sensor_msgs/msg/CompressedImage";
-
-    fn fast_cdr(data: &[u8]) -> Option<std::result::Result<Self, crate::log::cdr::CdrError>> {
-        Some(crate::log::fast::decode(data))
-    }
 
     fn from_value(mut v: Value) -> Result<Self> {
         Ok(CompressedImage {
@@ -180,10 +168,6 @@ pub struct CameraInfo {
 
 impl RosMessage for CameraInfo {
     const TYPE_NAME: &'static str = "sensor_msgs/msg/CameraInfo";
-
-    fn fast_cdr(data: &[u8]) -> Option<std::result::Result<Self, crate::log::cdr::CdrError>> {
-        Some(crate::log::fast::decode(data))
-    }
 
     fn from_value(mut v: Value) -> Result<Self> {
         Ok(CameraInfo {
@@ -253,10 +237,6 @@ pub struct Imu {
 
 impl RosMessage for Imu {
     const TYPE_NAME: &'static str = "sensor_msgs/msg/Imu";
-
-    fn fast_cdr(data: &[u8]) -> Option<std::result::Result<Self, crate::log::cdr::CdrError>> {
-        Some(crate::log::fast::decode(data))
-    }
 
     fn from_value(mut v: Value) -> Result<Self> {
         Ok(Imu {
