@@ -50,8 +50,9 @@ interop: $(VENV)/ok
 bench: $(VENV)/ok
 	$(CARGO) bench --bench render -- --noplot
 	$(CARGO) bench --bench read_decode -- --noplot
+	$(CARGO) build --release
 	$(VENV)/bin/python tools/bench_python_read.py target/bench-data/python_read.json
-	$(VENV)/bin/python tools/bench_compare.py target/criterion target/bench-data/python_read.json
+	$(VENV)/bin/python tools/bench_compare.py target/criterion target/bench-data/python_read.json target/release/peopletrack
 	$(MAKE) bench-mot
 	$(MAKE) bench-gmm
 	$(MAKE) bench-mlp

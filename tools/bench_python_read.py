@@ -1,5 +1,7 @@
 """Time Python mcap-ros2-support reading and fully decoding every message of the same logs the
-Rust benchmark reads (best of 3 runs). Writes {name: {seconds, messages, payload_bytes}}."""
+Rust benchmark reads (best of 3 runs), and decoding one topic alone (no output) for the rows
+that `peopletrack cat --topic T` is compared with. Writes {name: {seconds, messages,
+payload_bytes}}; the one-topic rows are named `cat:LOG:TOPIC`."""
 import json
 import os
 import sys
@@ -16,12 +18,16 @@ FILES = {
 FILES["images_640x480"] = os.path.join(ROOT, "target", "bench-data", "images_640x480.mcap")
 
 
-def decode_all(path):
+# `peopletrack cat LOG --topic T` is timed against Python decoding that topic alone.
+CAT_ROWS = [("general_tracking_moving_1", "/scan"), ("general_tracking_moving_1", "/tf")]
+
+
+def decode_all(path, topics=None):
     n = 0
     payload = 0
     with open(path, "rb") as f:
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
-        for _schema, _channel, message, _decoded in reader.iter_decoded_messages(log_time_order=True):
+        for _schema, _channel, message, _decoded in reader.iter_decoded_messages(topics=topics, log_time_order=True):
             n += 1
             payload += len(message.data)
     return n, payload
@@ -40,6 +46,17 @@ def main(out):
             best = min(best, time.perf_counter() - t0)
         results[name] = {"seconds": best, "messages": n, "payload_bytes": payload, "file_bytes": os.path.getsize(path)}
         print(f"python {name}: {best:.3f} s, {n} messages")
+    for name, topic in CAT_ROWS:
+        path = FILES[name]
+        if not os.path.exists(path):
+            continue
+        best = float("inf")
+        for _ in range(3):
+            t0 = time.perf_counter()
+            n, payload = decode_all(path, [topic])
+            best = min(best, time.perf_counter() - t0)
+        results[f"cat:{name}:{topic}"] = {"seconds": best, "messages": n, "payload_bytes": payload, "path": path, "topic": topic}
+        print(f"python {name} {topic} decode only: {best:.3f} s, {n} messages")
     os.makedirs(os.path.dirname(out), exist_ok=True)
     json.dump(results, open(out, "w"), indent=2)
 

@@ -7,6 +7,7 @@
 
 use std::path::PathBuf;
 
+use peopletrack::log::value::Json;
 use peopletrack::log::{Decoders, SessionLog};
 
 #[derive(Debug, clap::Args)]
@@ -43,14 +44,25 @@ pub fn run(args: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     for m in log.messages_on(&[args.topic.as_str()])?.take(limit) {
         let m = m?;
         let v = decoders.value(&log, &m)?;
-        let line = serde_json::json!({
-            "topic": m.topic(),
-            "log_time_ns": m.log_time.0,
-            "publish_time_ns": m.publish_time.0,
-            "sequence": m.sequence,
-            "message": v.to_json(args.max_array),
-        });
-        writeln!(out, "{line}")?;
+        let line = Line {
+            topic: m.topic(),
+            log_time_ns: m.log_time.0,
+            publish_time_ns: m.publish_time.0,
+            sequence: m.sequence,
+            message: v.json(args.max_array),
+        };
+        serde_json::to_writer(&mut *out, &line)?;
+        out.write_all(b"\n")?;
     }
     Ok(())
+}
+
+/// One output line, streamed by `serde_json` (no JSON tree is built; keys in this order).
+#[derive(serde::Serialize)]
+struct Line<'a> {
+    topic: &'a str,
+    log_time_ns: u64,
+    publish_time_ns: u64,
+    sequence: u32,
+    message: Json<'a>,
 }

@@ -7,6 +7,10 @@
 //! | `protobuf` | `protobuf` | [`super::protobuf`] with the embedded `FileDescriptorSet` |
 //! | `json` | `jsonschema` or none | `serde_json` |
 //!
+//! Channels of the high-rate standard types whose schema has the canonical layout decode by
+//! the typed fast paths of [`super::fast`] instead ([`Decoders::decode`], and
+//! [`Decoders::typed`] for those types).
+//!
 //! Typed reads ([`Decoders::typed`]) check that the channel carries the requested type (by ROS
 //! 2 name, or by one of its Foxglove equivalents) before converting.
 
@@ -17,6 +21,7 @@ use prost_reflect::MessageDescriptor;
 
 use super::cdr;
 use super::error::{LogError, LogErrorKind};
+use super::fast::{self, Decoded, FastKind, Scratch};
 use super::msgs::RosMessage;
 use super::protobuf::{self, FoxgloveMessage};
 use super::reader::{ChannelInfo, Message, SessionLog};
@@ -87,10 +92,30 @@ pub fn carries(ch: &ChannelInfo, type_name: &str) -> bool {
     normalize_type_name(ch.schema_name()).is_some_and(|n| n == type_name)
 }
 
+/// One channel's decoder and, for a standard type with the canonical layout, its fast path.
+#[derive(Debug)]
+struct Entry {
+    decoder: Result<Decoder, String>,
+    fast: Option<FastKind>,
+}
+
+impl Entry {
+    fn new(ch: &ChannelInfo) -> Entry {
+        let decoder = Decoder::for_channel(ch).map_err(|e| e.to_string());
+        let fast = match &decoder {
+            Ok(Decoder::Cdr(reg)) => FastKind::for_registry(reg),
+            _ => None,
+        };
+        Entry { decoder, fast }
+    }
+}
+
 /// Decoders per channel, built on first use. One per reading thread.
 #[derive(Debug, Default)]
 pub struct Decoders {
-    by_channel: HashMap<u16, Result<Decoder, String>>,
+    by_channel: HashMap<u16, Entry>,
+    /// Reused buffers of [`Decoders::decode`].
+    scratch: Scratch,
 }
 
 impl Decoders {
@@ -98,12 +123,16 @@ impl Decoders {
         Self::default()
     }
 
+    fn entry(&mut self, msg: &Message) -> &Entry {
+        let ch = &msg.channel;
+        self.by_channel
+            .entry(ch.id)
+            .or_insert_with(|| Entry::new(ch))
+    }
+
     fn decoder(&mut self, log: &SessionLog, msg: &Message) -> Result<&Decoder, LogError> {
         let ch = &msg.channel;
-        let entry = self
-            .by_channel
-            .entry(ch.id)
-            .or_insert_with(|| Decoder::for_channel(ch).map_err(|e| e.to_string()));
+        let entry = &self.entry(msg).decoder;
         entry.as_ref().map_err(|reason| {
             // the parse error is stored as text so it can be reported for every message
             let kind = Decoder::for_channel(ch)
@@ -125,8 +154,26 @@ impl Decoders {
         })
     }
 
+    /// Decode a message by its channel's typed fast path when it has one, else into a value
+    /// tree. The typed forms borrow buffers reused from message to message (no allocation once
+    /// they have grown) and images borrow their pixels from the payload.
+    pub fn decode<'s, 'm>(
+        &'s mut self,
+        log: &SessionLog,
+        msg: &'m Message,
+    ) -> Result<Decoded<'s, 'm>, LogError> {
+        match self.entry(msg).fast {
+            Some(kind) => self.scratch.decode(kind, &msg.data).map_err(|e| {
+                LogError::new(log.path(), LogErrorKind::from(e))
+                    .on_topic(msg.topic())
+                    .at(msg.log_time)
+            }),
+            None => self.value(log, msg).map(Decoded::Value),
+        }
+    }
+
     /// Decode a message as the typed `T`, from its ROS 2 type or a Foxglove equivalent.
-    pub fn typed<T: RosMessage + FoxgloveMessage>(
+    pub fn typed<T: RosMessage + FoxgloveMessage + 'static>(
         &mut self,
         log: &SessionLog,
         msg: &Message,
@@ -146,6 +193,11 @@ impl Decoders {
                 found: schema,
             }));
         }
+        if let Some(kind) = self.entry(msg).fast.filter(|_| is_ros)
+            && let Some(r) = fast::decode_as::<T>(kind, &msg.data)
+        {
+            return r.map_err(|e| err(e.into()));
+        }
         let v = self.value(log, msg)?;
         let typed = if is_ros {
             T::from_value(v)
@@ -157,7 +209,7 @@ impl Decoders {
 }
 
 /// Read every message of `topic` as `T`, in log-time order, as `(log_time, message)`.
-pub fn read_topic<T: RosMessage + FoxgloveMessage>(
+pub fn read_topic<T: RosMessage + FoxgloveMessage + 'static>(
     log: &SessionLog,
     topic: &str,
 ) -> Result<impl Iterator<Item = Result<(Nanos, T), LogError>>, LogError> {

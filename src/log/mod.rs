@@ -5,7 +5,8 @@
 //! - [`reader`]: streaming, log-time-ordered message iteration with bounded memory.
 //! - [`ros2msg`] + [`cdr`]: ROS 2 schemas and CDR for any type, custom ones included.
 //! - [`protobuf`]: Foxglove protobuf schemas; JSON channels decode with `serde_json`.
-//! - [`decode`]: which decoder reads which channel, and typed reads on top.
+//! - [`decode`]: which decoder reads which channel, and typed reads on top; [`fast`]: typed
+//!   CDR fast paths for the high-rate standard types, skipping the value tree.
 //! - [`msgs`]: typed forms of the ROS 2 messages pipelines consume; [`image`] decodes images.
 //! - [`tf`]: the transform tree with interpolated lookups; [`sync`]: nearest-stamp joins.
 //! - [`writer`]: sessions as `ros2 bag record` writes them; [`definitions`]: their schemas;
@@ -17,6 +18,7 @@ pub mod copy;
 pub mod decode;
 pub mod definitions;
 mod error;
+pub mod fast;
 pub mod image;
 pub mod msgs;
 pub mod protobuf;

@@ -10,6 +10,10 @@
 
 use std::sync::Arc;
 
+mod json;
+
+pub use json::Json;
+
 /// A decoded message or part of one.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Value {
@@ -384,6 +388,50 @@ mod tests {
             v.to_json(None).to_string(),
             r#"[1.5,"NaN","Infinity","-Infinity",0.0]"#
         );
+    }
+
+    /// The streamed rendering is byte-identical to printing the `serde_json` tree.
+    fn same_text(v: &Value, max: Option<usize>) {
+        let tree = v.to_json(max).to_string();
+        let streamed = serde_json::to_string(&v.json(max)).expect("serializes");
+        assert_eq!(streamed, tree);
+    }
+
+    #[test]
+    fn streamed_json_equals_the_tree_rendering() {
+        let v = record([
+            ("b", Value::Bool(true)),
+            ("i", Value::I8(-8)),
+            ("u", Value::U64(u64::MAX)),
+            ("l", Value::I64(i64::MIN)),
+            ("f", Value::F32(0.1)),
+            ("d", Value::F64(1e-310)),
+            ("e", Value::F64(-0.0)),
+            ("big", Value::F64(1.5e300)),
+            ("n", Value::F64(f64::NAN)),
+            ("s", Value::String("quote \" tab \t é \u{1} ☃".into())),
+            ("z", Value::Null),
+            ("empty", Value::Struct(vec![])),
+            (
+                "a",
+                Value::Array(vec![record([("x", Value::U16(7))]), Value::String("y".into())]),
+            ),
+            ("bs", Value::Bools(vec![true, false])),
+            ("by", Value::Bytes(vec![0, 255, 7])),
+            ("i8s", Value::I8s(vec![-1, 2])),
+            ("i16s", Value::I16s(vec![-300])),
+            ("u16s", Value::U16s(vec![65535])),
+            ("i32s", Value::I32s(vec![i32::MIN])),
+            ("u32s", Value::U32s(vec![u32::MAX, 0])),
+            ("i64s", Value::I64s(vec![])),
+            ("u64s", Value::U64s(vec![1, 2, 3])),
+            ("f32s", Value::F32s(vec![1.5, f32::NAN, f32::NEG_INFINITY, 3.4e38, 1e-45])),
+            ("f64s", Value::F64s(vec![0.1 + 0.2, f64::INFINITY, 123456789.0, 1e21])),
+        ]);
+        for max in [None, Some(0), Some(1), Some(2), Some(100)] {
+            same_text(&v, max);
+        }
+        same_text(&Value::F64s(vec![]), Some(0));
     }
 
     #[test]

@@ -51,17 +51,20 @@ pub(super) fn open_chunk(
     open_chunk_keeping(body, offset, channels, ids, &mut |_| Keep::Whole)
 }
 
-/// A reader that counts and checksums the bytes read through it.
+/// A reader that counts and checksums the bytes read through it (no checksum when the chunk
+/// stores none: rosbags writes 0 = not computed).
 struct Tally<R> {
     inner: R,
-    crc: crc32fast::Hasher,
+    crc: Option<crc32fast::Hasher>,
     count: u64,
 }
 
 impl<R: Read> Read for Tally<R> {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
         let n = self.inner.read(buf)?;
-        self.crc.update(&buf[..n]);
+        if let Some(crc) = &mut self.crc {
+            crc.update(&buf[..n]);
+        }
         self.count += n as u64;
         Ok(n)
     }
@@ -119,7 +122,7 @@ pub(super) fn open_chunk_keeping(
     };
     let mut r = Tally {
         inner,
-        crc: crc32fast::Hasher::new(),
+        crc: (h.crc != 0).then(crc32fast::Hasher::new),
         count: 0,
     };
     let data = walk(&mut r, want, keep).map_err(|e| match e {
@@ -136,8 +139,8 @@ pub(super) fn open_chunk_keeping(
             "gave more bytes than the {want} the header says"
         )));
     }
-    if h.crc != 0 {
-        let computed = r.crc.finalize();
+    if let Some(crc) = r.crc {
+        let computed = crc.finalize();
         if computed != h.crc {
             return Err(LogErrorKind::ChunkCrc {
                 offset,
