@@ -25,6 +25,7 @@ pub struct SessionData {
     pub camera: Vec<CameraObsRow>,
     pub truth: Vec<TruthRow>,
     pub planes: Vec<PlanesRow>,
+    pub fig4: Vec<tables::Fig4Row>,
     /// Method name → run and its scores.
     pub runs: BTreeMap<&'static str, (Run, Vec<Scored>)>,
     /// Session whose learned height the camera-only run starts from.
@@ -151,6 +152,7 @@ pub fn load(ctx: &Aggregate, p: &Params) -> anyhow::Result<Vec<SessionData>> {
             camera: tables::read(t, tables::CAMERA, n)?,
             truth: tables::read(t, tables::TRUTH, n)?,
             planes: tables::read(t, tables::PLANES, n)?,
+            fig4: tables::read(t, tables::FIG4, n)?,
             runs: BTreeMap::new(),
             height_from: String::new(),
         });

@@ -6,7 +6,7 @@
 use super::aggregate::{CAMERA_ONLY, FUSED, FUSED_CV, LASER_ONLY, METHODS, SessionData};
 use super::params::{Params, plane_name};
 use crate::report::figure::{
-    Figure, FigureKind, GroupedBars, LinePlot, Mark, Panels, Sensor, Series, TopView,
+    Figure, FigureKind, GroupedBars, ImageOverlay, LinePlot, Mark, Panels, Sensor, Series, TopView,
 };
 
 /// Every figure (empty when there is no session).
@@ -17,6 +17,7 @@ pub fn all(data: &[SessionData], p: &Params) -> Vec<Figure> {
         out.push(height(s, false));
         out.push(height(s, true));
         out.push(errors_over_time(s));
+        out.extend(frame_panels(s));
     }
     if let Some(s) = data.get(1) {
         out.push(top_view(s, p));
@@ -86,7 +87,7 @@ fn top_view(s: &SessionData, p: &Params) -> Figure {
         ..Figure::new(
             format!("fig3_top_view_{}", s.name),
             format!(
-                "Fig. 3: {}: top view — room, sensors, ground truth and the estimated paths (laser + camera; camera only from the height learned in {})",
+                "Fig. 3: {} top view (camera only: height from {})",
                 s.name, s.height_from
             ),
             FigureKind::TopView(TopView {
@@ -97,6 +98,30 @@ fn top_view(s: &SessionData, p: &Params) -> Figure {
             }),
         )
     }
+}
+
+/// Fig. 4 (composed in the session stage, see [`super::fig4`]).
+fn frame_panels(s: &SessionData) -> Option<Figure> {
+    let row = s.fig4.first()?;
+    let image = super::fig4::decode(row)?;
+    let t0 = s.runs[FUSED]
+        .0
+        .estimates
+        .first()
+        .map_or(row.stamp_ns, |e| e.stamp_ns);
+    Some(Figure::new(
+        format!("fig4_frame_{}", s.name),
+        format!(
+            "Fig. 4: {} frame {} (t = {:.1} s): estimate +, detection □ | motion | skin | laser, 3σ",
+            s.name,
+            row.frame_idx,
+            rel_s(row.stamp_ns, t0)
+        ),
+        FigureKind::Overlay(ImageOverlay {
+            image,
+            shapes: Vec::new(),
+        }),
+    ))
 }
 
 fn height(s: &SessionData, from_camera: bool) -> Figure {

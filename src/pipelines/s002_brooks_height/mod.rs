@@ -15,6 +15,7 @@
 
 mod aggregate;
 mod camera;
+mod fig4;
 mod figures;
 mod fusion;
 mod params;
@@ -34,7 +35,7 @@ pub struct BrooksHeight;
 
 impl Experiment for BrooksHeight {
     const KIND: &'static str = "s002_brooks_height";
-    const VERSION: u32 = 1;
+    const VERSION: u32 = 2;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

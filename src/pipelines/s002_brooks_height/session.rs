@@ -11,9 +11,9 @@
 use anyhow::Context;
 use nalgebra::UnitQuaternion;
 
-use super::camera;
 use super::params::Params;
 use super::tables::{self, LaserObsRow, TruthRow};
+use super::{camera, fig4};
 use crate::frames::laser::{self as laser_frames, LaserOptions};
 use crate::frames::{rig, truth};
 use crate::groundtruth::PEOPLE_TOPIC;
@@ -76,6 +76,7 @@ pub(super) fn process(
         out.insert(tables::CAMERA.into(), tables::CameraObsRow::frame(&[])?);
         out.insert(tables::TRUTH.into(), TruthRow::frame(&[])?);
         out.insert(tables::PLANES.into(), tables::PlanesRow::frame(&[])?);
+        out.insert(tables::FIG4.into(), tables::Fig4Row::frame(&[])?);
         return Ok(out);
     }
     if log.summary().channel(&p.scan_topic).is_none() {
@@ -115,6 +116,17 @@ pub(super) fn process(
     let obs = camera::observations(&frames, p, &model, &cam.world_from_camera)?;
     bar.set_message("plane grid");
     let planes = camera::plane_grid(&frames, p)?;
+    bar.set_message("fig. 4");
+    let fig4 = fig4::compose(
+        log,
+        p,
+        &frames,
+        &laser,
+        &obs,
+        &model,
+        &cam.world_from_camera,
+    )?;
+    out.insert(tables::FIG4.into(), tables::Fig4Row::frame(&fig4)?);
     out.insert(tables::LASER.into(), LaserObsRow::frame(&laser)?);
     out.insert(tables::CAMERA.into(), tables::CameraObsRow::frame(&obs)?);
     out.insert(tables::TRUTH.into(), TruthRow::frame(&truth_rows)?);

@@ -11,6 +11,7 @@ pub const LASER: &str = "laser_obs";
 pub const CAMERA: &str = "camera_obs";
 pub const TRUTH: &str = "truth";
 pub const PLANES: &str = "planes";
+pub const FIG4: &str = "fig4";
 
 table_row! {
     /// A leg pair on a scan (§3): range–bearing of the midpoint in the laser frame, and the
@@ -84,6 +85,16 @@ table_row! {
         pub false_detections: i64,
         /// Mean distance of the detected head top to the true head-top pixel.
         pub head_err_px: Option<f64>,
+    }
+}
+
+table_row! {
+    /// Fig. 4's four panels of one frame as a PNG (base64): `fig4` (at most one row).
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct Fig4Row {
+        pub frame_idx: i64,
+        pub stamp_ns: i64,
+        pub png_base64: String,
     }
 }
 
