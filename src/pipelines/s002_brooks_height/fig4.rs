@@ -43,6 +43,24 @@ fn mask_image(mask: &[u8], w: u32, h: u32) -> RgbImage {
     })
 }
 
+/// The 3σ ellipse of a 2×2 covariance around `(x, y)` as a closed polyline.
+pub fn ellipse(x: f64, y: f64, c: [[f64; 2]; 2], k: f64) -> Vec<(f64, f64)> {
+    let (a, b, d) = (c[0][0], c[0][1], c[1][1]);
+    let tr = (a + d) / 2.0;
+    let det = (a * d - b * b).max(0.0);
+    let disc = (tr * tr - det).max(0.0).sqrt();
+    let (l1, l2) = (tr + disc, (tr - disc).max(0.0));
+    let theta = 0.5 * (2.0 * b).atan2(a - d);
+    let (s, co) = theta.sin_cos();
+    (0..=48)
+        .map(|i| {
+            let t = std::f64::consts::TAU * f64::from(i) / 48.0;
+            let (u, v) = (k * l1.sqrt() * t.cos(), k * l2.sqrt() * t.sin());
+            (x + co * u - s * v, y + s * u + co * v)
+        })
+        .collect()
+}
+
 /// The laser panel: scan returns and the 3σ ellipse, `room` scaled into `w × h`.
 fn laser_panel(
     p: &Params,
@@ -70,7 +88,7 @@ fn laser_panel(
         draw_filled_circle_mut(&mut img, (u as i32, v as i32), 1, Rgb([60, 60, 60]));
     }
     if let Some(e) = est {
-        let pts = super::figures::ellipse(e.x, e.y, e.pos_cov, 3.0);
+        let pts = ellipse(e.x, e.y, e.pos_cov, 3.0);
         for pair in pts.windows(2) {
             draw_line_segment_mut(
                 &mut img,
@@ -195,4 +213,28 @@ pub fn decode(row: &Fig4Row) -> Option<RgbImage> {
         .decode(&row.png_base64)
         .ok()?;
     image::load_from_memory(&bytes).ok().map(|i| i.to_rgb8())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_3_sigma_ellipse_of_a_diagonal_covariance_has_its_axes_on_x_and_y() {
+        // σx = 2, σy = 1 around (1, 1): 3σ extremes at x = 1 ± 6, y = 1 ± 3
+        let pts = ellipse(1.0, 1.0, [[4.0, 0.0], [0.0, 1.0]], 3.0);
+        let max_x = pts.iter().map(|p| p.0).fold(f64::MIN, f64::max);
+        let min_y = pts.iter().map(|p| p.1).fold(f64::MAX, f64::min);
+        assert!(
+            (max_x - 7.0).abs() < 1e-9 && (min_y + 2.0).abs() < 1e-9,
+            "{max_x} {min_y}"
+        );
+        // a correlated covariance: every point at Mahalanobis distance 3
+        let c = [[2.0, 0.8], [0.8, 1.0]];
+        let det = c[0][0] * c[1][1] - c[0][1] * c[0][1];
+        for (x, y) in ellipse(0.0, 0.0, c, 3.0) {
+            let d2 = (c[1][1] * x * x - 2.0 * c[0][1] * x * y + c[0][0] * y * y) / det;
+            assert!((d2 - 9.0).abs() < 1e-9, "{d2}");
+        }
+    }
 }

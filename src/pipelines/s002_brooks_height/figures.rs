@@ -30,24 +30,6 @@ fn rel_s(t: i64, t0: i64) -> f64 {
     (t - t0) as f64 * 1e-9
 }
 
-/// The 3σ ellipse of a 2×2 covariance around `(x, y)` as a closed polyline.
-pub fn ellipse(x: f64, y: f64, c: [[f64; 2]; 2], k: f64) -> Vec<(f64, f64)> {
-    let (a, b, d) = (c[0][0], c[0][1], c[1][1]);
-    let tr = (a + d) / 2.0;
-    let det = (a * d - b * b).max(0.0);
-    let disc = (tr * tr - det).max(0.0).sqrt();
-    let (l1, l2) = (tr + disc, (tr - disc).max(0.0));
-    let theta = 0.5 * (2.0 * b).atan2(a - d);
-    let (s, co) = theta.sin_cos();
-    (0..=48)
-        .map(|i| {
-            let t = std::f64::consts::TAU * f64::from(i) / 48.0;
-            let (u, v) = (k * l1.sqrt() * t.cos(), k * l2.sqrt() * t.sin());
-            (x + co * u - s * v, y + s * u + co * v)
-        })
-        .collect()
-}
-
 fn top_view(s: &SessionData, p: &Params) -> Figure {
     let [x0, y0, x1, y1] = p.room_m;
     let mut sensors = Vec::new();
@@ -76,7 +58,7 @@ fn top_view(s: &SessionData, p: &Params) -> Figure {
             if let Some(e) = run.last() {
                 traj.push(Series::line(
                     format!("{name}: final 3σ ellipse"),
-                    ellipse(e.x, e.y, e.pos_cov, 3.0),
+                    super::fig4::ellipse(e.x, e.y, e.pos_cov, 3.0),
                     k + 1,
                 ));
             }

@@ -307,4 +307,54 @@ mod tests {
             "{xy:?}"
         );
     }
+
+    #[test]
+    fn scoring_measures_the_lag_behind_a_moving_target() {
+        // truth moves along +x at 1 m/s; a constant-position estimate 0.2 m behind at
+        // every stamp: error 0.2, lag +0.2 m along the motion; extrapolated CV: no lag
+        let p = Params::default();
+        let truth: Vec<TruthRow> = (0..5)
+            .map(|k| TruthRow {
+                stamp_ns: k * 200_000_000,
+                x: 0.2 * k as f64,
+                y: 1.0,
+                vx: 1.0,
+                vy: 0.0,
+                height_m: 1.8,
+            })
+            .collect();
+        let est = |k: i64| Estimate {
+            stamp_ns: k * 200_000_000,
+            camera_event: false,
+            x: 0.2 * k as f64 - 0.2,
+            y: 1.0,
+            h: 1.8,
+            sigma_h: 0.1,
+            vx: 1.0,
+            vy: 0.0,
+            pos_cov: [[0.01, 0.0], [0.0, 0.01]],
+        };
+        let run = Run {
+            estimates: (0..5).map(est).collect(),
+            ..Run::default()
+        };
+        let s = score(&run, &truth, &p, Motion::ConstantPosition);
+        assert_eq!(s.len(), 5);
+        for r in &s {
+            assert!(
+                (r.error_m - 0.2).abs() < 1e-12 && (r.along_m.expect("moving") - 0.2).abs() < 1e-12
+            );
+        }
+        // a CV estimate from 0.2 s earlier, extrapolated with the true velocity, lands on the truth
+        let run = Run {
+            estimates: vec![Estimate {
+                stamp_ns: 0,
+                x: 0.0,
+                ..est(0)
+            }],
+            ..Run::default()
+        };
+        let s = score(&run, &truth, &p, Motion::ConstantVelocity);
+        assert!(s.iter().all(|r| r.error_m < 1e-9), "{s:?}");
+    }
 }
