@@ -4,6 +4,7 @@
 pub mod dataset_quality;
 pub mod laser_people;
 pub mod s000_cielniak_omni;
+pub mod s002_brooks_height;
 pub mod s003_zivkovic_background;
 pub mod s004_mohedano_multicam;
 
@@ -35,6 +36,7 @@ registry!(
     dataset_quality::DatasetQuality,
     laser_people::LaserPeople,
     s000_cielniak_omni::OmniAppearance,
+    s002_brooks_height::BrooksHeight,
     s003_zivkovic_background::BackgroundTracking,
     s004_mohedano_multicam::MulticamCylinders,
 );

@@ -35,7 +35,13 @@ pub struct Body {
     pub skin: Rgb,
     pub hair: Rgb,
     pub hat: Option<Rgb>,
+    /// Skin-coloured hands at the ends of the arms (opt-in per scenario person, `hands = true`:
+    /// seed 002's skin detection; off, the arms end in the sleeve as before).
+    pub hands: bool,
 }
+
+/// Radius of a hand (a sphere at the end of the arm), m.
+pub const HAND_RADIUS: f64 = 0.05;
 
 pub const ANKLE_Z: f64 = 0.07;
 pub const HEAD_HALF_HEIGHT: f64 = 0.12;
@@ -52,6 +58,7 @@ impl Body {
             skin: p.skin,
             hair: p.hair,
             hat: p.hat,
+            hands: p.hands,
         }
     }
 
@@ -185,35 +192,57 @@ impl Body {
                 cloth(self.upper),
                 id,
             ));
+            if self.hands {
+                let palm = hand - Vector3::new(0.0, 0.0, HAND_RADIUS);
+                out.push(
+                    Primitive::new(
+                        Shape::Ellipsoid {
+                            center: palm,
+                            radii: Vector3::new(HAND_RADIUS, HAND_RADIUS, HAND_RADIUS),
+                            yaw: 0.0,
+                        },
+                        Material::flat(self.skin),
+                        id,
+                    )
+                    .skin_below(f64::INFINITY),
+                );
+            }
         }
-        out.push(Primitive::new(
-            Shape::Cylinder {
-                x: s.x,
-                y: s.y,
-                z0: shoulder_z,
-                z1: h - 2.0 * HEAD_HALF_HEIGHT + 0.03,
-                r: 0.055,
-            },
-            Material::flat(self.skin),
-            id,
-        ));
-        let head = self.head_center(s);
-        out.push(Primitive::new(
-            Shape::Ellipsoid {
-                center: head,
-                radii: Vector3::new(0.1, 0.085, HEAD_HALF_HEIGHT),
-                yaw: s.heading,
-            },
-            Material {
-                albedo: linear(self.skin),
-                texture: Texture::Split {
-                    z: (head.z + 0.035) as f32,
-                    above: linear(self.hair),
+        out.push(
+            Primitive::new(
+                Shape::Cylinder {
+                    x: s.x,
+                    y: s.y,
+                    z0: shoulder_z,
+                    z1: h - 2.0 * HEAD_HALF_HEIGHT + 0.03,
+                    r: 0.055,
                 },
-                emissive: false,
-            },
-            id,
-        ));
+                Material::flat(self.skin),
+                id,
+            )
+            .skin_below(f64::INFINITY),
+        );
+        let head = self.head_center(s);
+        let hairline = head.z + 0.035;
+        out.push(
+            Primitive::new(
+                Shape::Ellipsoid {
+                    center: head,
+                    radii: Vector3::new(0.1, 0.085, HEAD_HALF_HEIGHT),
+                    yaw: s.heading,
+                },
+                Material {
+                    albedo: linear(self.skin),
+                    texture: Texture::Split {
+                        z: hairline as f32,
+                        above: linear(self.hair),
+                    },
+                    emissive: false,
+                },
+                id,
+            )
+            .skin_below(hairline),
+        );
         if let Some(hat) = self.hat {
             out.push(Primitive::new(
                 Shape::Cylinder {
@@ -262,6 +291,7 @@ mod tests {
             skin: [210, 160, 130],
             hair: [40, 30, 20],
             hat: Some([0, 180, 0]),
+            hands: false,
         }
     }
 
@@ -311,5 +341,36 @@ mod tests {
             .fold(f64::INFINITY, f64::min);
         // the leg axis leans from hip to ankle; at 0.25 m it is at x = 3.0 for a standing person
         assert!((t - (3.0 - 0.065)).abs() < 1e-3, "{t}");
+    }
+
+    #[test]
+    fn hands_are_opt_in_and_skin_is_marked_on_face_neck_and_hands_only() {
+        let s = PersonState {
+            x: 1.0,
+            y: 2.0,
+            heading: 0.3,
+            speed: 0.0,
+            vx: 0.0,
+            vy: 0.0,
+            phase: 0.0,
+        };
+        let mut plain = Vec::new();
+        body().primitives(&s, &mut plain);
+        let mut b = body();
+        b.hands = true;
+        let mut with = Vec::new();
+        b.primitives(&s, &mut with);
+        assert_eq!(with.len(), plain.len() + 2);
+        let skin: Vec<Option<f64>> = plain.iter().map(|p| p.skin_below).collect();
+        // neck (always skin) and head (skin below the hairline, 3.5 cm above the head centre)
+        let hairline = 1.8 - HEAD_HALF_HEIGHT + 0.035;
+        assert_eq!(skin.iter().filter(|z| z.is_some()).count(), 2);
+        assert!(skin.contains(&Some(f64::INFINITY)));
+        assert!(skin.contains(&Some(hairline)));
+        let hands = with
+            .iter()
+            .filter(|p| p.skin_below == Some(f64::INFINITY))
+            .count();
+        assert_eq!(hands, 3, "neck + two hands");
     }
 }

@@ -55,6 +55,8 @@ pub struct Frame {
     pub rgb: Vec<u8>,
     /// Object id of the nearest surface per pixel (0: static background or nothing).
     pub ids: Vec<u32>,
+    /// Ground-truth skin per pixel: the nearest surface is a person's skin (face, neck, hands).
+    pub skin: Vec<bool>,
 }
 
 /// What changes per frame.
@@ -369,10 +371,12 @@ impl Camera {
         let key = rng::hash(input.noise_key, &[self.index]);
         let mut rgb = vec![0u8; wu * hu * 3];
         let mut ids = vec![0u32; wu * hu];
+        let mut skin = vec![false; wu * hu];
         rgb.par_chunks_mut(wu * 3)
             .zip(ids.par_chunks_mut(wu))
+            .zip(skin.par_chunks_mut(wu))
             .enumerate()
-            .for_each(|(y, (row, id_row))| {
+            .for_each(|(y, ((row, id_row), skin_row))| {
                 for x in 0..wu {
                     let i = y * wu + x;
                     let (o, d, static_t) = match &self.cache {
@@ -441,8 +445,10 @@ impl Camera {
                     if let Some((t, n, prim)) =
                         nearest(input.dynamic, dyn_tiles.at(x, y), &o, &d, t_best)
                     {
-                        lin = shade(input.world, input.t, &(o + d * t), &n, prim, input.shadows);
+                        let p = o + d * t;
+                        lin = shade(input.world, input.t, &p, &n, prim, input.shadows);
                         id = prim.object;
+                        skin_row[x] = prim.skin_below.is_some_and(|z| p.z < z);
                     }
                     id_row[x] = id;
                     for (c, v) in lin.iter().enumerate() {
@@ -460,6 +466,7 @@ impl Camera {
             height: h,
             rgb,
             ids,
+            skin,
         }
     }
 

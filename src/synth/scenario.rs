@@ -287,6 +287,10 @@ pub struct PersonSpec {
     #[serde(default = "default_hair")]
     pub hair: Rgb,
     pub hat: Option<Rgb>,
+    /// Render skin-coloured hands (seed 002's skin detection). Off by default so that other
+    /// datasets render exactly as before.
+    #[serde(default)]
+    pub hands: bool,
     /// Present from `enter_s` to `leave_s` (seconds from the session start).
     #[serde(default)]
     pub enter_s: f64,
@@ -449,6 +453,10 @@ pub struct CameraCommon {
     /// Also publish the exact person mask `/<name>/ground_truth_mask`.
     #[serde(default)]
     pub mask: bool,
+    /// Also publish the exact skin mask `/<name>/ground_truth_skin` (face, neck, hands: what
+    /// seed 002's skin histogram is trained and scored on).
+    #[serde(default)]
+    pub skin_mask: bool,
 }
 
 fn default_noise() -> f64 {

@@ -159,6 +159,9 @@ pub struct Primitive {
     pub object: u32,
     pub center: Point3<f64>,
     pub radius: f64,
+    /// Ground-truth skin: hits on this primitive below this height (m) are skin pixels in the
+    /// optional skin mask (`None`: never skin). Changes no rendered colour.
+    pub skin_below: Option<f64>,
 }
 
 impl Primitive {
@@ -170,7 +173,14 @@ impl Primitive {
             object,
             center,
             radius,
+            skin_below: None,
         }
+    }
+
+    /// The same primitive, its hits below `z` (m) marked as skin in the ground-truth skin mask.
+    pub fn skin_below(mut self, z: f64) -> Primitive {
+        self.skin_below = Some(z);
+        self
     }
 }
 

@@ -5,10 +5,13 @@
 //! - [`jpda`]: joint probabilistic data association (gated clusters, exact joint events, the
 //!   PDAF combined-innovation update).
 //! - [`graph_match`]: 2-D tracking by graph matching of rectangles (seed 004 §4).
+//! - [`height_ekf`]: the (x, y, height) EKF of seed 002 §5 — laser range–bearing and camera
+//!   bearing + elevation updates, 3σ gate; a constant-velocity variant.
 //! - [`cylinders`]: multi-camera 3-D tracking of people as cylinders (seed 004 §5).
 
 pub mod cylinders;
 pub mod graph_match;
+pub mod height_ekf;
 pub mod jpda;
 pub mod kalman;
 pub mod position;

@@ -19,6 +19,10 @@
 //! - [`synthetic`]: a deterministic synthetic RGB scene (textured background, noise, a
 //!   flickering region, a moving object with a shadow) for tests and benchmarks.
 //! - [`gabor`]: the Gabor-feature background model and MAD threshold of seed 004 §2.
+//! - [`jabri`]: seed 002 §4's background subtraction after Jabri et al. (colour × edge planes,
+//!   recursive mean and σ with forgetting, moving-blob rectangles).
+//! - [`skin`]: seed 002 §4's skin segmentation (normalised-rgb histogram back-projection,
+//!   smoothing, hysteresis bounded by Canny edges) and the top-fifth person test.
 //! - [`template`]: human-silhouette template detection of seed 004 §3.
 //!
 //! Kernels read frames and write into buffers the caller owns; nothing here reads logs or
@@ -29,9 +33,11 @@ pub mod colortrack;
 pub mod ellipse;
 pub mod gabor;
 pub mod gmm;
+pub mod jabri;
 pub mod local;
 pub mod omni;
 pub mod score;
+pub mod skin;
 pub mod synthetic;
 pub mod template;
 pub mod view;

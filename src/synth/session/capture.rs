@@ -373,19 +373,28 @@ fn write_frame(
             .iter()
             .map(|id| if *id >= PERSON_BASE { 255 } else { 0 })
             .collect();
-        w.write(
-            ch,
-            log,
-            &Image {
-                header,
-                height: hgt,
-                width: wdt,
-                encoding: "mono8".into(),
-                is_bigendian: 0,
-                step: wdt,
-                data,
-            },
-        )?;
+        w.write(ch, log, &mono8(header.clone(), wdt, hgt, data))?;
+    }
+    if let Some(ch) = c.skin_channel {
+        let data: Vec<u8> = frame
+            .skin
+            .iter()
+            .map(|s| if *s { 255 } else { 0 })
+            .collect();
+        w.write(ch, log, &mono8(header, wdt, hgt, data))?;
     }
     Ok(())
+}
+
+/// A `mono8` ground-truth mask image.
+fn mono8(header: Header, width: u32, height: u32, data: Vec<u8>) -> Image {
+    Image {
+        header,
+        height,
+        width,
+        encoding: "mono8".into(),
+        is_bigendian: 0,
+        step: width,
+        data,
+    }
 }

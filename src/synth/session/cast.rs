@@ -230,6 +230,7 @@ fn actors(
                     25,
                 ],
                 hat: None,
+                hands: false,
             };
             let stay = c.stay_s[0] + r.random::<f64>() * (c.stay_s[1] - c.stay_s[0]);
             // spread arrivals over the session

@@ -40,6 +40,8 @@ pub(super) struct CameraSensor {
     pub mask: bool,
     /// Image, camera info and (when recorded) ground-truth mask.
     pub channels: (ChannelId, ChannelId, Option<ChannelId>),
+    /// Ground-truth skin mask channel, when the camera records one (`skin_mask = true`).
+    pub skin_channel: Option<ChannelId>,
 }
 
 /// A laser scanner as the session runs it.
@@ -275,6 +277,11 @@ impl Builder<'_> {
         } else {
             None
         };
+        let skin_channel = if camera.skin_mask {
+            Some(w.add_ros2::<Image>(&format!("/{}/ground_truth_skin", camera.name))?)
+        } else {
+            None
+        };
         self.sensors.push(SensorRuntime::Camera(CameraSensor {
             cam: Box::new(cam),
             frame_id: camera.name.clone(),
@@ -285,6 +292,7 @@ impl Builder<'_> {
             quality: camera.jpeg_quality,
             mask: camera.mask,
             channels: (image_ch, info_ch, mask_ch),
+            skin_channel,
         }));
         Ok(())
     }

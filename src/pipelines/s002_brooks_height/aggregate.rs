@@ -1,0 +1,415 @@
+//! The aggregation: every session's filters ([`super::fusion`]), the height table with its
+//! one-sample t-test against the truth, position errors and lag per method with paired
+//! t-tests, and §4's plane grid averaged over the sessions.
+
+use std::collections::BTreeMap;
+
+use super::fusion::{self, Method, Run, Scored, Sensors};
+use super::params::Params;
+use super::tables::{self, CameraObsRow, LaserObsRow, PlanesRow, TruthRow};
+use crate::eval::stats;
+use crate::report::rows::Rows;
+use crate::report::table::Table;
+use crate::run::{Aggregate, Products};
+use crate::table_row;
+use crate::track::height_ekf::Motion;
+
+/// The paper's numbers (§6) for the notes.
+pub const PAPER_HEIGHT_M: f64 = 1.87;
+pub const PAPER_TRUTH_M: f64 = 1.84;
+
+/// One session's inputs and filter runs.
+pub struct SessionData {
+    pub name: String,
+    pub laser: Vec<LaserObsRow>,
+    pub camera: Vec<CameraObsRow>,
+    pub truth: Vec<TruthRow>,
+    pub planes: Vec<PlanesRow>,
+    pub fig4: Vec<tables::Fig4Row>,
+    /// Method name → run and its scores.
+    pub runs: BTreeMap<&'static str, (Run, Vec<Scored>)>,
+    /// Session whose learned height the camera-only run starts from.
+    pub height_from: String,
+}
+
+pub const FUSED: &str = "laser+camera";
+pub const LASER_ONLY: &str = "laser only";
+pub const CAMERA_ONLY: &str = "camera only";
+pub const FUSED_CV: &str = "laser+camera CV (ours)";
+
+/// Methods in table order.
+pub const METHODS: [&str; 4] = [FUSED, LASER_ONLY, CAMERA_ONLY, FUSED_CV];
+
+table_row! {
+    /// Final height per session: `height`.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct HeightRow {
+        pub session: String,
+        pub truth_m: f64,
+        pub final_m: Option<f64>,
+        pub sigma_m: Option<f64>,
+        pub error_m: Option<f64>,
+        pub final_cv_m: Option<f64>,
+        pub camera_accepted: i64,
+        pub camera_rejected: i64,
+        pub laser_accepted: i64,
+        pub laser_rejected: i64,
+        pub first_camera_s: Option<f64>,
+    }
+}
+
+table_row! {
+    /// One-sample t-test of the final heights against the truth: `height_ttest`.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct HeightTestRow {
+        pub sessions: i64,
+        pub truth_m: f64,
+        pub mean_m: Option<f64>,
+        pub std_m: Option<f64>,
+        pub t: Option<f64>,
+        pub p_two_sided: Option<f64>,
+        pub ci_low_m: Option<f64>,
+        pub ci_high_m: Option<f64>,
+        pub paper_m: f64,
+        pub paper_truth_m: f64,
+    }
+}
+
+table_row! {
+    /// Position error and lag per session and method (`all`: pooled): `position_error`.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct ErrorRow {
+        pub session: String,
+        pub method: String,
+        pub n: i64,
+        pub mean_m: Option<f64>,
+        pub rmse_m: Option<f64>,
+        pub p95_m: Option<f64>,
+        /// Mean of (truth − estimate) along the direction of motion while moving (m).
+        pub lag_m: Option<f64>,
+        /// lag_m over the mean speed then (s).
+        pub lag_s: Option<f64>,
+        pub camera_from: String,
+    }
+}
+
+table_row! {
+    /// Paired t-test of two methods' errors at the same truth stamps: `paired_ttest`.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct PairRow {
+        pub method_a: String,
+        pub method_b: String,
+        pub n: i64,
+        pub mean_a_m: f64,
+        pub mean_b_m: f64,
+        pub mean_diff_m: f64,
+        pub t: Option<f64>,
+        pub p_two_sided: Option<f64>,
+    }
+}
+
+fn method(name: &'static str, learned: (f64, f64)) -> Method {
+    match name {
+        LASER_ONLY => Method {
+            name,
+            sensors: Sensors::LaserOnly,
+            motion: Motion::ConstantPosition,
+        },
+        CAMERA_ONLY => Method {
+            name,
+            sensors: Sensors::CameraOnly {
+                h_m: learned.0,
+                sigma_h_m: learned.1,
+            },
+            motion: Motion::ConstantPosition,
+        },
+        FUSED_CV => Method {
+            name,
+            sensors: Sensors::Fused,
+            motion: Motion::ConstantVelocity,
+        },
+        _ => Method {
+            name: FUSED,
+            sensors: Sensors::Fused,
+            motion: Motion::ConstantPosition,
+        },
+    }
+}
+
+/// Read every session and run its filters; the camera-only run of session k starts from the
+/// height that laser + camera learned in session k − 1 (the first from the last; a single
+/// session from itself, said in the table).
+pub fn load(ctx: &Aggregate, p: &Params) -> anyhow::Result<Vec<SessionData>> {
+    let mut out = Vec::new();
+    for (info, t) in ctx.sessions {
+        if p.is_training(&info.path) {
+            continue;
+        }
+        let n = &info.name;
+        out.push(SessionData {
+            name: n.clone(),
+            laser: tables::read(t, tables::LASER, n)?,
+            camera: tables::read(t, tables::CAMERA, n)?,
+            truth: tables::read(t, tables::TRUTH, n)?,
+            planes: tables::read(t, tables::PLANES, n)?,
+            fig4: tables::read(t, tables::FIG4, n)?,
+            runs: BTreeMap::new(),
+            height_from: String::new(),
+        });
+    }
+    let fused: Vec<Option<(f64, f64)>> = out
+        .iter()
+        .map(|s| {
+            let r = fusion::run(&s.laser, &s.camera, p, method(FUSED, (0.0, 0.0)));
+            r.last().map(|e| (e.h, e.sigma_h))
+        })
+        .collect();
+    let n = out.len();
+    for k in 0..n {
+        let from = (k + n - 1) % n;
+        let learned = fused[from].unwrap_or((p.h0_m, p.sigma_h0_m));
+        out[k].height_from = out[from].name.clone();
+        for name in METHODS {
+            let m = method(name, learned);
+            let s = &out[k];
+            let run = fusion::run(&s.laser, &s.camera, p, m);
+            let scored = fusion::score(&run, &s.truth, p, m.motion);
+            out[k].runs.insert(name, (run, scored));
+        }
+    }
+    Ok(out)
+}
+
+fn mean(v: &[f64]) -> Option<f64> {
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+}
+
+fn error_row(session: &str, method: &str, scored: &[&Scored], camera_from: &str) -> ErrorRow {
+    let e: Vec<f64> = scored.iter().map(|s| s.error_m).collect();
+    let mut sorted = e.clone();
+    sorted.sort_by(f64::total_cmp);
+    let along: Vec<(f64, f64)> = scored
+        .iter()
+        .filter_map(|s| s.along_m.map(|a| (a, s.speed)))
+        .collect();
+    let lag = mean(&along.iter().map(|a| a.0).collect::<Vec<_>>());
+    let speed = mean(&along.iter().map(|a| a.1).collect::<Vec<_>>());
+    ErrorRow {
+        session: session.into(),
+        method: method.into(),
+        n: e.len() as i64,
+        mean_m: mean(&e),
+        rmse_m: mean(&e.iter().map(|x| x * x).collect::<Vec<_>>()).map(f64::sqrt),
+        p95_m: (!sorted.is_empty()).then(|| {
+            sorted[((sorted.len() as f64 * 0.95).ceil() as usize).clamp(1, sorted.len()) - 1]
+        }),
+        lag_m: lag,
+        lag_s: lag.zip(speed).map(|(l, v)| l / v),
+        camera_from: camera_from.into(),
+    }
+}
+
+/// Errors of `a` and `b` at the truth stamps both scored, pooled over sessions.
+fn paired(data: &[SessionData], a: &str, b: &str) -> (Vec<f64>, Vec<f64>) {
+    let (mut xa, mut xb) = (Vec::new(), Vec::new());
+    for s in data {
+        let (Some((_, sa)), Some((_, sb))) = (s.runs.get(a), s.runs.get(b)) else {
+            continue;
+        };
+        let by: BTreeMap<i64, f64> = sb.iter().map(|r| (r.stamp_ns, r.error_m)).collect();
+        for r in sa {
+            if let Some(e) = by.get(&r.stamp_ns) {
+                xa.push(r.error_m);
+                xb.push(*e);
+            }
+        }
+    }
+    (xa, xb)
+}
+
+/// The result tables (see the module doc).
+pub fn tables(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow::Result<()> {
+    let mut heights = Vec::new();
+    for s in data {
+        let truth = s.truth.first().map_or(f64::NAN, |t| t.height_m);
+        let (run, _) = &s.runs[FUSED];
+        let last = run.last();
+        heights.push(HeightRow {
+            session: s.name.clone(),
+            truth_m: truth,
+            final_m: last.map(|e| e.h),
+            sigma_m: last.map(|e| e.sigma_h),
+            error_m: last.map(|e| e.h - truth),
+            final_cv_m: s.runs[FUSED_CV].0.last().map(|e| e.h),
+            camera_accepted: run.camera_accepted as i64,
+            camera_rejected: run.camera_rejected as i64,
+            laser_accepted: run.laser_accepted as i64,
+            laser_rejected: run.laser_rejected as i64,
+            first_camera_s: run
+                .first_camera_ns
+                .zip(run.estimates.first())
+                .map(|(c, e)| (c - e.stamp_ns) as f64 * 1e-9),
+        });
+    }
+    let finals: Vec<f64> = heights.iter().filter_map(|h| h.final_m).collect();
+    let truth = heights.first().map_or(f64::NAN, |h| h.truth_m);
+    let summary = stats::describe(&finals).ok();
+    let test = stats::paired_t(&finals, &vec![truth; finals.len()], p.level).ok();
+    let ttest = HeightTestRow {
+        sessions: finals.len() as i64,
+        truth_m: truth,
+        mean_m: mean(&finals),
+        std_m: summary.as_ref().map(|s| s.std),
+        t: test.as_ref().map(|t| t.t),
+        p_two_sided: test.as_ref().map(|t| t.p_two_sided),
+        ci_low_m: test.as_ref().map(|t| truth + t.ci_low),
+        ci_high_m: test.as_ref().map(|t| truth + t.ci_high),
+        paper_m: PAPER_HEIGHT_M,
+        paper_truth_m: PAPER_TRUTH_M,
+    };
+    let mut t = Table::new(
+        "height",
+        "Height learned by laser + camera at the end of each session vs the truth (seed 002 §6: 1.87 m vs 1.84 m)",
+        HeightRow::frame(&heights)?,
+    );
+    for c in [
+        "truth_m",
+        "final_m",
+        "sigma_m",
+        "error_m",
+        "final_cv_m",
+        "first_camera_s",
+    ] {
+        t = t.with_precision(c, 3);
+    }
+    out.tables.push(t.with_note(format!(
+        "EKF over (x, y, h), constant position, h0 = {} m with sigma {} m, 3-sigma gate (Mahalanobis <= {}); camera/laser accepted and rejected count observation events (a rejected camera event is one whose every detection implied a state outside the gate). first_camera_s: first camera detection after the filter started.",
+        p.h0_m, p.sigma_h0_m, p.gate_sigma
+    )));
+    let mut t = Table::new(
+        "height_ttest",
+        "Final heights over the sessions: mean, std and a one-sample t-test against the truth",
+        HeightTestRow::frame(&[ttest])?,
+    );
+    for c in [
+        "truth_m",
+        "mean_m",
+        "std_m",
+        "t",
+        "p_two_sided",
+        "ci_low_m",
+        "ci_high_m",
+    ] {
+        t = t.with_precision(c, 4);
+    }
+    out.tables.push(t.with_note(format!(
+        "Two-sided, level {}; the paper reports one trial ({PAPER_HEIGHT_M} m vs {PAPER_TRUTH_M} m), so it has no test.",
+        p.level
+    )));
+    error_tables(data, p, out)
+}
+
+fn error_tables(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow::Result<()> {
+    let mut rows = Vec::new();
+    for name in METHODS {
+        let mut pooled: Vec<&Scored> = Vec::new();
+        for s in data {
+            let scored: Vec<&Scored> = s.runs[name].1.iter().collect();
+            let from = if name == CAMERA_ONLY {
+                s.height_from.as_str()
+            } else {
+                ""
+            };
+            rows.push(error_row(&s.name, name, &scored, from));
+            pooled.extend(scored);
+        }
+        rows.push(error_row("all", name, &pooled, ""));
+    }
+    let mut t = Table::new(
+        "position_error",
+        "Position error against the ground truth (m) and the lag along the direction of motion, per session and method",
+        ErrorRow::frame(&rows)?,
+    );
+    for c in ["mean_m", "rmse_m", "p95_m", "lag_m", "lag_s"] {
+        t = t.with_precision(c, 3);
+    }
+    out.tables.push(t.with_note(format!(
+        "Scored at every ground-truth stamp from the filter's start with its latest estimate (constant velocity: extrapolated). lag_m: mean of (truth − estimate) along the true velocity while faster than {} m/s; positive = behind (the paper: 'position estimates lag slightly behind moving targets'). camera only starts from the height and sigma laser + camera learned in session camera_from. laser+camera CV is our addition (white-noise acceleration {} m²/s³).",
+        p.lag_min_speed, p.q_pos_cv
+    )));
+    let mut pairs = Vec::new();
+    for (a, b) in [
+        (FUSED, LASER_ONLY),
+        (FUSED, CAMERA_ONLY),
+        (LASER_ONLY, CAMERA_ONLY),
+        (FUSED_CV, FUSED),
+    ] {
+        let (xa, xb) = paired(data, a, b);
+        let test = stats::paired_t(&xa, &xb, p.level).ok();
+        pairs.push(PairRow {
+            method_a: a.into(),
+            method_b: b.into(),
+            n: xa.len() as i64,
+            mean_a_m: mean(&xa).unwrap_or(f64::NAN),
+            mean_b_m: mean(&xb).unwrap_or(f64::NAN),
+            mean_diff_m: test.as_ref().map_or(f64::NAN, |t| t.mean_diff),
+            t: test.as_ref().map(|t| t.t),
+            p_two_sided: test.as_ref().map(|t| t.p_two_sided),
+        });
+    }
+    let mut t = Table::new(
+        "paired_ttest",
+        "Position errors of two methods at the same ground-truth stamps (all sessions): paired t-test",
+        PairRow::frame(&pairs)?,
+    );
+    for c in ["mean_a_m", "mean_b_m", "mean_diff_m", "t", "p_two_sided"] {
+        t = t.with_precision(c, 4);
+    }
+    out.tables.push(t.with_note(format!(
+        "Two-sided, level {}; mean_diff = a − b (negative: a closer to the truth). Successive errors are autocorrelated, so the p-values are optimistic.",
+        p.level
+    )));
+    planes_table(data, out)
+}
+
+fn planes_table(data: &[SessionData], out: &mut Products) -> anyhow::Result<()> {
+    let mut rows: Vec<PlanesRow> = Vec::new();
+    for cfg in super::params::PLANE_GRID {
+        let name = super::params::plane_name(cfg.0, cfg.1);
+        let all: Vec<&PlanesRow> = data
+            .iter()
+            .flat_map(|s| s.planes.iter().filter(|r| r.config == name))
+            .collect();
+        let Some(first) = all.first() else { continue };
+        let frames: i64 = all.iter().map(|r| r.frames).sum();
+        let wmean = |f: &dyn Fn(&PlanesRow) -> f64| {
+            all.iter().map(|r| f(r) * r.frames as f64).sum::<f64>() / frames.max(1) as f64
+        };
+        let errs: Vec<f64> = all.iter().filter_map(|r| r.head_err_px).collect();
+        rows.push(PlanesRow {
+            config: name.clone(),
+            planes: first.planes,
+            frames,
+            ms_per_frame: wmean(&|r| r.ms_per_frame),
+            precision: wmean(&|r| r.precision),
+            recall: wmean(&|r| r.recall),
+            f1: wmean(&|r| r.f1),
+            person_frames: all.iter().map(|r| r.person_frames).sum(),
+            detected_frames: all.iter().map(|r| r.detected_frames).sum(),
+            false_detections: all.iter().map(|r| r.false_detections).sum(),
+            head_err_px: mean(&errs),
+        });
+    }
+    let mut t = Table::new(
+        "planes",
+        "Seed 002 §4 scaling: background-subtraction time per frame and detection quality, 1 / 3 colour × 0 / 1 / 2 edge planes",
+        PlanesRow::frame(&rows)?,
+    );
+    for c in ["ms_per_frame", "precision", "recall", "f1", "head_err_px"] {
+        t = t.with_precision(c, 3);
+    }
+    out.tables.push(t.with_note(
+        "ms_per_frame: the Jabri split + update + test alone, on the thread of its session (sessions run in parallel), this machine and build (timings vary run to run; compare the ratios); precision/recall/F1 of the moving-pixel mask against the exact person mask; detected_frames: frames with a person detection (moving blob with skin in its top fifth) within 20 px of the true head top; means over sessions weighted by frames.",
+    ));
+    Ok(())
+}
