@@ -21,6 +21,7 @@ help:
 	@echo "make bench-gmm         adaptive GMM frames/s beside OpenCV MOG2 on the same frames, with ratios"
 	@echo "make bench-multicam    seed 004: frames/s of the whole s004_mohedano_multicam pipeline per camera and of the Gabor background alone"
 	@echo "make bench-laser       laser legs + tracker (GNN, JPDA) scans/s on the real logs, one thread, as a multiple of real time and of decoding"
+	@echo "make fuzz      cargo-fuzz (nightly): seed corpora from the real logs, then FUZZ_RUNS (10M) executions per target; make fuzz-install installs cargo-fuzz"
 	@echo "make clean     remove build outputs and out/"
 
 release:
@@ -116,3 +117,36 @@ bench-gmm: $(VENV)/opencv-ok
 clean:
 	$(CARGO) clean
 	rm -rf out
+
+# Fuzzing (issue 19): cargo-fuzz on the nightly toolchain; never needed by eval or test.
+# `make fuzz` builds seed corpora (prefixes and small rewrites of the real laser logs and a
+# synthetic log, their schemas and payloads, the pipeline files) and runs each target for
+# FUZZ_RUNS executions (one target: FUZZ_TARGETS=cdr_decode). Without sanitizer (safe Rust;
+# libFuzzer still catches panics, aborts, stack overflows, timeouts and RSS over the limit),
+# with debug assertions and overflow checks on. Crashes land in fuzz/artifacts/<target>/.
+.PHONY: fuzz fuzz-install fuzz-seeds
+FUZZ_RUNS ?= 10000000
+FUZZ_TARGETS ?= mcap_reader ros2msg_schema cdr_decode protobuf_decode pipeline_file
+FUZZ_SEEDS := fuzz/seeds
+FUZZ_LOGS := $(wildcard ../shared/real/laser/*/*.mcap) $(firstword $(wildcard datasets/home_tour/*.mcap))
+FUZZ_FLAGS := -s none -a
+FUZZ_LIBFUZZER := -rss_limit_mb=1024 -timeout=10 -max_len=65536 -print_final_stats=1
+
+fuzz-install:
+	@rustup toolchain list | grep -q '^nightly' || rustup toolchain install nightly --profile minimal
+	@cargo +nightly fuzz --version >/dev/null 2>&1 || cargo +nightly install cargo-fuzz --locked
+
+fuzz-seeds:
+	rm -rf $(FUZZ_SEEDS)
+	$(CARGO) run --quiet --example fuzz_seeds -- $(FUZZ_SEEDS) $(FUZZ_LOGS)
+	mkdir -p $(FUZZ_SEEDS)/pipeline_file
+	cp pipelines/*.toml tests/fixtures/*.toml $(FUZZ_SEEDS)/pipeline_file/
+
+fuzz: fuzz-install fuzz-seeds
+	cargo +nightly fuzz build $(FUZZ_FLAGS)
+	@for t in $(FUZZ_TARGETS); do \
+		mkdir -p fuzz/corpus/$$t; \
+		echo "== $$t: $(FUZZ_RUNS) runs"; \
+		cargo +nightly fuzz run $(FUZZ_FLAGS) $$t fuzz/corpus/$$t $(FUZZ_SEEDS)/$$t -- \
+			-runs=$(FUZZ_RUNS) $(FUZZ_LIBFUZZER) || exit 1; \
+	done

@@ -224,6 +224,38 @@ fn degenerate_s000_values_are_errors_naming_the_parameter() {
         "train_fraction = 1.0 ",
         "params.train_fraction",
     );
+    check(
+        s000,
+        "sweep_learning_rates = [0.05, 0.1, 0.3, 0.5, 0.8]",
+        "sweep_learning_rates = []",
+        "params.sweep_learning_rates",
+    );
+}
+
+/// `pipelines::check_text` (what the `pipeline_file` fuzz target drives) gives the same
+/// errors as `run` without any file or session, and accepts every shipped pipeline file.
+#[test]
+fn check_text_validates_without_running() {
+    use peopletrack::pipelines::check_text;
+    let path = Path::new("x.toml");
+    for name in [
+        "dataset_quality",
+        "laser_people",
+        "s000_cielniak_omni",
+        "s003_zivkovic_background",
+        "s004_mohedano_multicam",
+    ] {
+        let text = shipped(name);
+        check_text(path, &text).unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+    let bad = shipped("s000_cielniak_omni").replace("epochs = 2000 ", "epochs = 0 ");
+    let want = format!("x.toml:{}: `params.epochs`", line(&bad, "epochs = 0 "));
+    let err = check_text(path, &bad).expect_err("epochs = 0").to_string();
+    assert!(err.starts_with(&want), "{err}");
+    let err = check_text(path, "[pipeline]\nname = \"a\"\nkind = \"nope\"\n")
+        .expect_err("unknown kind")
+        .to_string();
+    assert!(err.contains("unknown pipeline kind `nope`"), "{err}");
 }
 
 #[test]

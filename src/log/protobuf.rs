@@ -21,9 +21,26 @@ use nalgebra::{Quaternion, Vector3};
 use std::sync::Arc;
 
 /// The message descriptor named by a schema record, from its `FileDescriptorSet` bytes.
+///
+/// The set is decoded here first and each file's `syntax` checked: `prost-reflect` 0.16.5
+/// panics (index out of bounds while labelling the error) on a syntax other than `proto2` or
+/// `proto3`, found by the `protobuf_decode` fuzz target.
 pub fn descriptor(schema_name: &str, descriptor_set: &[u8]) -> Result<MessageDescriptor, String> {
-    let pool = DescriptorPool::decode(descriptor_set)
-        .map_err(|e| format!("schema `{schema_name}` is not a valid FileDescriptorSet: {e}"))?;
+    use prost_reflect::prost::Message as _;
+    use prost_reflect::prost_types::FileDescriptorSet;
+    let invalid = |e: &dyn std::fmt::Display| {
+        format!("schema `{schema_name}` is not a valid FileDescriptorSet: {e}")
+    };
+    let set = FileDescriptorSet::decode(descriptor_set).map_err(|e| invalid(&e))?;
+    if let Some(f) = set
+        .file
+        .iter()
+        .find(|f| !matches!(f.syntax.as_deref(), None | Some("proto2") | Some("proto3")))
+    {
+        let why = format!("file `{}` has unknown syntax {:?}", f.name(), f.syntax());
+        return Err(invalid(&why));
+    }
+    let pool = DescriptorPool::from_file_descriptor_set(set).map_err(|e| invalid(&e))?;
     pool.get_message_by_name(schema_name)
         .ok_or_else(|| format!("FileDescriptorSet has no message named `{schema_name}`"))
 }

@@ -10,7 +10,9 @@ pub mod s004_mohedano_multicam;
 
 use std::path::Path;
 
-use crate::run::{Experiment, RunOptions, RunSummary, config, run_experiment, unknown_kind};
+use crate::run::{
+    Experiment, RunOptions, RunSummary, check_experiment, config, run_experiment, unknown_kind,
+};
 
 /// The one list of experiments: each type's `KIND` is listed in [`KINDS`] and dispatched by
 /// [`run_file`].
@@ -28,6 +30,18 @@ macro_rules! registry {
                 }
             )*
             Err(unknown_kind(path, &kind, KINDS).into())
+        }
+
+        /// Parse and validate a pipeline file's text as its `kind` (no sessions are looked
+        /// for, nothing is run): what `run` checks first. `path` only names it in errors.
+        pub fn check_text(path: &Path, text: &str) -> Result<(), config::ConfigError> {
+            let kind = config::kind_of(path, text)?;
+            $(
+                if kind == <$ty as Experiment>::KIND {
+                    return check_experiment::<$ty>(path, text).map(|_| ());
+                }
+            )*
+            Err(unknown_kind(path, &kind, KINDS))
         }
     };
 }

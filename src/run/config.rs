@@ -105,11 +105,17 @@ pub fn read_kind(path: &Path) -> Result<(String, String), ConfigError> {
         path: path.to_path_buf(),
         source,
     })?;
-    let k: KindOnly = toml::from_str(&text).map_err(|e| ConfigError::Parse {
+    let kind = kind_of(path, &text)?;
+    Ok((text, kind))
+}
+
+/// The `pipeline.kind` of a pipeline file's text (`path` only names it in errors).
+pub fn kind_of(path: &Path, text: &str) -> Result<String, ConfigError> {
+    let k: KindOnly = toml::from_str(text).map_err(|e| ConfigError::Parse {
         path: path.to_path_buf(),
         message: e.to_string().trim_end().to_string(),
     })?;
-    Ok((text, k.pipeline.kind))
+    Ok(k.pipeline.kind)
 }
 
 /// Parse the whole file with the experiment's parameter type.

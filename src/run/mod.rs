@@ -254,15 +254,25 @@ struct Plan<P> {
     sessions: Vec<SessionRef>,
 }
 
+/// Parse and validate a pipeline file's text (`path` only names it in errors) as experiment
+/// `E`, and plan its stages: everything `run` checks before it looks for sessions.
+pub fn check_experiment<E: Experiment>(
+    path: &Path,
+    text: &str,
+) -> Result<(PipelineFile<E::Params>, Vec<Stage>), ConfigError> {
+    let file: PipelineFile<E::Params> = config::parse(path, text)?;
+    config::check(path, text, E::validate(&file.params))?;
+    config::check_topics(path, text, &file.topics, &E::topic_keys(&file.params))?;
+    let stages = E::plan(&file.params, &file.topics);
+    Ok((file, stages))
+}
+
 fn plan<E: Experiment>(
     path: &Path,
     text: &str,
     opts: &RunOptions,
 ) -> anyhow::Result<Plan<E::Params>> {
-    let file: PipelineFile<E::Params> = config::parse(path, text)?;
-    config::check(path, text, E::validate(&file.params))?;
-    config::check_topics(path, text, &file.topics, &E::topic_keys(&file.params))?;
-    let stages = E::plan(&file.params, &file.topics);
+    let (file, stages) = check_experiment::<E>(path, text)?;
     let patterns = opts
         .sessions
         .clone()

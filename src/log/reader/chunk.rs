@@ -183,7 +183,12 @@ fn walk<R: Read>(
         let mut head = [0u8; RECORD_HEAD_LEN];
         r.read_exact(&mut head)?;
         let (opcode, len) = record_head(&head);
-        let left = want - r.count;
+        // the record head itself may run past the chunk's declared size (found by fuzzing)
+        let Some(left) = want.checked_sub(r.count) else {
+            return Err(Walk::Bad(format!(
+                "record head at chunk byte {at} runs past the chunk's {want} uncompressed bytes"
+            )));
+        };
         if len > left {
             return Err(Walk::Bad(format!(
                 "record at chunk byte {at} claims {len} bytes, {left} left"

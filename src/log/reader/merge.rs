@@ -378,7 +378,7 @@ impl Indexed {
                     record: "chunk",
                     offset: chunk.offset,
                     reason: format!(
-                        "chunks overlapping in time up to {} s hold {} bytes of messages at                          once, more than the {MAX_HELD_BYTES} byte budget",
+                        "chunks overlapping in time up to {} s hold {} bytes of messages at once, more than the {MAX_HELD_BYTES} byte budget",
                         chunk.end, self.merge.held
                     ),
                 });

@@ -125,6 +125,12 @@ pub fn validate(p: &Params) -> Vec<Invalid> {
     {
         bad("sweep_learning_rates", format!("{lr} is not in (0, 10)"));
     }
+    if !p.sweep_hidden.is_empty() && p.sweep_learning_rates.is_empty() {
+        bad(
+            "sweep_learning_rates",
+            "[] leaves the sweep over `sweep_hidden` empty: give at least one learning rate (or `sweep_hidden = []` for no sweep)".into(),
+        );
+    }
     for (key, n, what) in [
         ("splits", p.splits, "random splits"),
         (
