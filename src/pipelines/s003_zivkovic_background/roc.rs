@@ -95,6 +95,8 @@ struct RocModel {
 pub(super) struct RocRun {
     models: Vec<RocModel>,
     skip_frames: usize,
+    /// Frames with an exact mask seen (scored or not).
+    masked_frames: usize,
     camera: String,
     /// `[walking, standing]`.
     people: [PeopleCounts; 2],
@@ -133,6 +135,7 @@ impl RocRun {
         Ok(Self {
             models,
             skip_frames: p.roc.skip_frames,
+            masked_frames: 0,
             camera: p.camera.clone(),
             people,
         })
@@ -145,6 +148,7 @@ impl RocRun {
             return Ok(());
         }
         let scored = f.index as usize >= self.skip_frames;
+        self.masked_frames += 1;
         let npx = truth.len();
         self.models
             .par_iter_mut()
@@ -182,6 +186,16 @@ impl RocRun {
     pub fn finish(self, out: &mut SessionTables) -> anyhow::Result<()> {
         if self.models.is_empty() {
             return Ok(());
+        }
+        if self.masked_frames > 0 && self.models.iter().all(|m| m.frames == 0) {
+            // every masked frame fell inside the skipped start: the ROC would be 0/0 = NaN
+            anyhow::bail!(
+                "`params.roc.skip_frames` = {} leaves no frame to score: the session has {} \
+                 frames with exact masks, all among its first {} frames",
+                self.skip_frames,
+                self.masked_frames,
+                self.skip_frames
+            );
         }
         let rows: Vec<RocCounts> = self
             .models
@@ -616,6 +630,30 @@ mod tests {
                 .expect("reads")
                 .is_none()
         );
+    }
+
+    #[test]
+    fn skip_frames_past_every_masked_frame_is_an_error_naming_it() {
+        let p = Params::default();
+        // masked frames were seen, none was scored: 0/0 would be a NaN table
+        let mut run = RocRun::new(&p, true).expect("models");
+        run.masked_frames = 3;
+        let err = run
+            .finish(&mut SessionTables::new())
+            .expect_err("nothing scored")
+            .to_string();
+        assert!(
+            err.starts_with("`params.roc.skip_frames` = 45 leaves no frame to score")
+                && err.contains(" 3 frames with exact masks"),
+            "{err}"
+        );
+        // a session without masks has no ROC at all, and is not an error
+        let mut out = SessionTables::new();
+        RocRun::new(&p, true)
+            .expect("models")
+            .finish(&mut out)
+            .expect("no masks");
+        assert!(out.contains_key(COUNTS_TABLE));
     }
 
     #[test]
