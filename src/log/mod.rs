@@ -9,7 +9,8 @@
 //! - [`msgs`]: typed forms of the ROS 2 messages pipelines consume; [`image`] decodes images.
 //! - [`tf`]: the transform tree with interpolated lookups; [`sync`]: nearest-stamp joins.
 //! - [`writer`]: sessions as `ros2 bag record` writes them; [`definitions`]: their schemas;
-//!   [`copy`]: a copy of a log with messages added (tracks written back as markers).
+//!   [`copy`]: a copy of a log with messages added (tracks written back as markers);
+//!   [`import`]: public datasets (WILDTRACK) written as session logs.
 
 mod camera_info;
 pub mod cdr;
@@ -18,6 +19,7 @@ pub mod decode;
 pub mod definitions;
 mod error;
 pub mod image;
+pub mod import;
 pub mod msgs;
 pub mod protobuf;
 pub mod reader;
