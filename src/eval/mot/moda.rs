@@ -23,8 +23,11 @@ pub struct Moda {
     pub recall: f64,
 }
 
-/// Score frames of `(ground truth, detections)` points `(x, y)` (m) at `max_m`.
-pub fn moda_modp(frames: &[(Vec<[f64; 2]>, Vec<[f64; 2]>)], max_m: f64) -> Moda {
+/// One frame: ground-truth points and detected points `(x, y)` (m).
+pub type PointFrame = (Vec<[f64; 2]>, Vec<[f64; 2]>);
+
+/// Score frames of `(ground truth, detections)` points at `max_m`.
+pub fn moda_modp(frames: &[PointFrame], max_m: f64) -> Moda {
     let (mut gt, mut tp, mut fp, mut sum) = (0usize, 0usize, 0usize, 0.0);
     for (g, h) in frames {
         let dist = |i: usize, j: usize| {

@@ -5,7 +5,7 @@
 
 use std::collections::BTreeMap;
 
-use crate::eval::mot::{Geometry, Observation, moda_modp};
+use crate::eval::mot::{Geometry, Observation, PointFrame, moda_modp};
 use crate::pipelines::s004_mohedano_multicam::scored::{
     Key, Scored, hypothesis_observations, truth_observations,
 };
@@ -33,9 +33,9 @@ mod rows {
 }
 pub(crate) use rows::ModaRow;
 
-type Frames = BTreeMap<i64, (Vec<[f64; 2]>, Vec<[f64; 2]>)>;
+type Frames = BTreeMap<i64, PointFrame>;
 
-fn by_frame(gt: &[Observation], hyp: &[Observation]) -> Vec<(Vec<[f64; 2]>, Vec<[f64; 2]>)> {
+fn by_frame(gt: &[Observation], hyp: &[Observation]) -> Vec<PointFrame> {
     let mut frames: Frames = BTreeMap::new();
     for (side, obs) in [(0, gt), (1, hyp)] {
         for o in obs {

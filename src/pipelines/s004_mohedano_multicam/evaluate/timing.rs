@@ -26,8 +26,11 @@ crate::table_row! {
     }
 }
 
+/// `(detector, association, cameras)` → (milliseconds, 2-D objects) of every frame.
+type Groups = BTreeMap<(String, String, i64), (Vec<f64>, Vec<f64>)>;
+
 pub(super) fn table(s: &Scored) -> anyhow::Result<Table> {
-    let mut groups: BTreeMap<(String, String, i64), (Vec<f64>, Vec<f64>)> = BTreeMap::new();
+    let mut groups = Groups::new();
     for r in s.data.iter().flat_map(|d| &d.timing) {
         let g = groups
             .entry((r.detector.clone(), r.association.clone(), r.cameras))
