@@ -5,12 +5,13 @@ VENV := target/py-venv
 # py-motmetrics needs numpy 1, OpenCV 4.12 numpy 2: separate throwaway environments
 VENV_MOT := target/py-venv-mot
 
-.PHONY: help eval datasets release test bench interop clean opencv-agreement bench-gmm bench-multicam bench-laser
+.PHONY: help eval datasets release test bench interop clean opencv-agreement bench-gmm bench-multicam bench-laser wildtrack
 
 PROFILE ?= quick
 
 help:
 	@echo "make eval      build (release), synthesize the default datasets if absent, run every pipeline, write out/ and out/REPORT.md"
+	@echo "make wildtrack import ../shared/real/wildtrack (if present) and run pipelines/real/s004_wildtrack.toml"
 	@echo "make datasets  synthesize every dataset in datasets/ whose logs are absent (PROFILE=quick|full)"
 	@echo "make test      build and run every test (the CI command)"
 	@echo "make bench     criterion benchmarks + the same reads in Python mcap-ros2-support, with ratios"
@@ -32,6 +33,16 @@ datasets: release
 
 eval: datasets
 	./target/release/peopletrack eval --profile $(PROFILE)
+	$(MAKE) wildtrack
+
+# WILDTRACK (real, ../shared/real/wildtrack): imported once into datasets/wildtrack/, then seed
+# 004's 3-D stage on its annotated boxes (pipelines/real/s004_wildtrack.toml). SKIPPED when absent.
+WILDTRACK_DIR ?= ../shared/real/wildtrack
+wildtrack: release
+	@if [ -d $(WILDTRACK_DIR)/annotations_positions ]; then \
+	  [ -f datasets/wildtrack/wildtrack.mcap ] || ./target/release/peopletrack import wildtrack $(WILDTRACK_DIR) -o datasets/wildtrack/wildtrack.mcap; \
+	  ./target/release/peopletrack run pipelines/real/s004_wildtrack.toml $(if $(filter full,$(PROFILE)),--out out/full,); \
+	else echo "SKIPPED: $(WILDTRACK_DIR) is absent (WILDTRACK E6 run)"; fi
 
 test:
 	$(CARGO) test --locked

@@ -4,6 +4,7 @@
 
 pub mod cat;
 pub mod eval;
+pub mod import;
 pub mod inspect;
 pub mod progress;
 pub mod run;
@@ -58,6 +59,9 @@ pub enum Command {
     /// Train a model on your own logs and save it for `run` to load, e.g.
     /// `peopletrack train omni-appearance --sessions 'logs/*.mcap'`.
     Train(train::Args),
+    /// Write a public dataset as a session log, e.g.
+    /// `peopletrack import wildtrack ../shared/real/wildtrack -o wildtrack.mcap`.
+    Import(import::Args),
 }
 
 /// Parse arguments, run the command, and map the outcome to an exit code:
@@ -85,6 +89,7 @@ pub fn main() -> ExitCode {
         Command::Synth(a) => synth::run(a, &mut out),
         Command::Score(a) => score::run(a, &mut out),
         Command::Train(a) => train::run(a, &mut out),
+        Command::Import(a) => import::run(a, &mut out),
     }
     .and_then(|()| out.flush().map_err(anyhow::Error::from));
     match result {

@@ -10,7 +10,8 @@
 //! - [`msgs`]: typed forms of the ROS 2 messages pipelines consume; [`image`] decodes images.
 //! - [`tf`]: the transform tree with interpolated lookups; [`sync`]: nearest-stamp joins.
 //! - [`writer`]: sessions as `ros2 bag record` writes them; [`definitions`]: their schemas;
-//!   [`copy`]: a copy of a log with messages added (tracks written back as markers).
+//!   [`copy`]: a copy of a log with messages added (tracks written back as markers);
+//!   [`import`]: public datasets (WILDTRACK) written as session logs.
 
 mod camera_info;
 pub mod cdr;
@@ -20,6 +21,7 @@ pub mod definitions;
 mod error;
 pub mod fast;
 pub mod image;
+pub mod import;
 pub mod msgs;
 pub mod protobuf;
 pub mod reader;

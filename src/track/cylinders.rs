@@ -37,6 +37,11 @@
 //! within `2·p_Th` are tried — a pair's error is at most about `N_c/2` times the whole
 //! combination's, so this drops almost nothing; the step reports when it happened.
 //!
+//! **Association variants** ([`Association`]): `Paper` is the exhaustive search above;
+//! `Scalable` ([`scalable`]) builds new objects from pairwise-coherent head rays grown camera
+//! by camera and from box bottoms on the ground (single-camera people), with the same greedy
+//! selection by `E_c`.
+//!
 //! What it does not do: no appearance, no re-identification of discarded objects, no
 //! occlusion reasoning beyond what the combinations express.
 
@@ -48,6 +53,7 @@ use super::kalman::{Kalman, constant_velocity_2d};
 use crate::geometry::triangulate::{CalibratedView, triangulate_rays};
 
 mod head;
+mod scalable;
 
 pub use head::{box_head_px, cylinder_radius};
 
@@ -71,6 +77,20 @@ pub struct Object2d {
     pub head_px: [f64; 2],
     /// Width of the object's box (pixels), for eq. 6.
     pub width_px: f64,
+    /// Bottom centre of the object's box (raw pixels): its ground point, used only by
+    /// [`Association::Scalable`].
+    pub foot_px: Option<[f64; 2]>,
+}
+
+/// How new 3-D objects are found among the free 2-D objects.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Association {
+    /// Every combination (the paper's §5), pairwise-coherent ones above `max_combinations`.
+    #[default]
+    Paper,
+    /// Pairwise ray seeds grown camera by camera, plus ground points ([`scalable`]).
+    Scalable,
 }
 
 /// Which error chooses between valid combinations.
@@ -104,6 +124,10 @@ pub struct CylinderParams {
     pub gate_m: f64,
     /// Above this many combinations, only pairwise-coherent ones are tried.
     pub max_combinations: usize,
+    pub association: Association,
+    /// Scalable: a single-camera ground point this close to a selected or tracked person
+    /// (m) is a view of that person, not a new one.
+    pub ground_separation_m: f64,
     /// Frame period (s).
     pub dt_s: f64,
     /// White-noise acceleration on the ground (m/s²).
@@ -129,6 +153,8 @@ impl Default for CylinderParams {
             room_margin_m: 0.5,
             gate_m: 1.0,
             max_combinations: 20_000,
+            association: Association::Paper,
+            ground_separation_m: 0.5,
             dt_s: 0.04,
             accel_sigma: 2.0,
             position_sigma_m: 0.1,
@@ -176,6 +202,8 @@ struct Prepared {
     ideal: Point2<f64>,
     origin: Point3<f64>,
     dir: nalgebra::Vector3<f64>,
+    /// Where the ray through the box bottom meets the ground (z = 0).
+    ground: Option<Point3<f64>>,
 }
 
 /// A valid combination: its support, triangulated head and errors.
@@ -307,6 +335,11 @@ impl CylinderTracker {
                 let view = &self.views[o.camera];
                 let px = Point2::new(o.head_px[0], o.head_px[1]);
                 let (origin, dir) = view.ray_in_world(&px)?;
+                let ground = o.foot_px.and_then(|f| {
+                    let (fo, fd) = view.ray_in_world(&Point2::new(f[0], f[1]))?;
+                    let t = -fo.z / fd.z;
+                    (t.is_finite() && t > 0.0).then(|| fo + fd * t)
+                });
                 Some(Prepared {
                     camera: o.camera,
                     id: o.id,
@@ -315,6 +348,7 @@ impl CylinderTracker {
                     ideal: view.ideal_px(&px)?,
                     origin,
                     dir,
+                    ground,
                 })
             })
             .collect();
@@ -333,7 +367,10 @@ impl CylinderTracker {
     fn evaluate(&self, prepared: &[Prepared], combo: &[usize]) -> Option<Hypothesis> {
         let p = &self.params;
         if combo.len() < p.min_cameras {
-            return None;
+            return match (p.association, combo) {
+                (Association::Scalable, &[i]) => self.ground_hypothesis(prepared, i),
+                _ => None,
+            };
         }
         let rays: Vec<(Point3<f64>, nalgebra::Vector3<f64>)> = combo
             .iter()
@@ -523,7 +560,10 @@ impl CylinderTracker {
         let prepared = self.prepare(objects);
         let (f, q) = self.transition();
         let mut used = self.update_objects(&prepared, (&f, &q), &mut stats);
-        let selected = self.select_new(&prepared, &mut used, &mut stats);
+        let selected = match self.params.association {
+            Association::Paper => self.select_new(&prepared, &mut used, &mut stats),
+            Association::Scalable => self.select_new_scalable(&prepared, &mut used, &mut stats),
+        };
         self.continue_candidates(selected, (&f, &q), &mut stats);
         (self.cylinders(), stats)
     }

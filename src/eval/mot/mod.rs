@@ -47,6 +47,7 @@ mod clear;
 mod error;
 mod hota;
 mod identity;
+mod moda;
 mod motchallenge;
 
 use std::collections::HashMap;
@@ -55,6 +56,7 @@ pub use clear::{ClearMot, Event, EventKind};
 pub use error::{MotError, Side};
 pub use hota::{HOTA_ALPHAS, Hota, HotaAtAlpha, hota_alpha};
 pub use identity::IdMetrics;
+pub use moda::{Moda, PointFrame, moda_modp};
 pub use motchallenge::{parse_motchallenge, write_motchallenge};
 
 /// An axis-aligned image box in pixels: top-left corner, width and height.

@@ -83,7 +83,7 @@ pub(crate) fn topics(p: &Params, remap: &BTreeMap<String, String>) -> Topics {
 
 impl Experiment for MulticamCylinders {
     const KIND: &'static str = "s004_mohedano_multicam";
-    const VERSION: u32 = 2;
+    const VERSION: u32 = 3;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

@@ -3,7 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::run::config::Invalid;
-use crate::track::cylinders::Selection;
+use crate::track::cylinders::{Association, Selection};
 
 /// Where the 2-D objects of the main run come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -82,6 +82,12 @@ pub struct Params {
     pub room_margin_m: f64,
     pub gate_m: f64,
     pub max_combinations: usize,
+    /// New 3-D objects: `paper` (exhaustive combinations) or `scalable` (pairwise ray seeds
+    /// grown camera by camera, plus single-camera ground points; `track::cylinders`).
+    pub association: Association,
+    /// `scalable`: a single-camera ground point this close to a person already found is a
+    /// view of that person (m).
+    pub ground_separation_m: f64,
     // evaluation
     /// CLEAR MOT / IDF1 matching thresholds on the ground (m).
     pub match_m: Vec<f64>,
@@ -138,6 +144,8 @@ impl Default for Params {
             room_margin_m: 0.5,
             gate_m: 1.0,
             max_combinations: 20_000,
+            association: Association::Paper,
+            ground_separation_m: 0.5,
             match_m: vec![0.5, 1.0],
             n_app_sweep: (1..=10).collect(),
             occluded_visibility: 0.8,
@@ -258,6 +266,12 @@ pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
     }
     if p.max_combinations == 0 {
         bad("max_combinations", "must be at least 1".into());
+    }
+    if !(p.ground_separation_m >= 0.0 && p.ground_separation_m.is_finite()) {
+        bad(
+            "ground_separation_m",
+            format!("{} is not a finite distance ≥ 0 m", p.ground_separation_m),
+        );
     }
     if p.n_app_sweep.contains(&0) {
         bad("n_app_sweep", "values must be at least 1".into());

@@ -54,6 +54,8 @@ pub(crate) struct SessionData {
     pub calibration: Vec<CalibRow>,
     pub session: SessionRow,
     pub view: Option<CachedView>,
+    /// MEASURED: the main run's 3-D stage per frame.
+    pub timing: Vec<tables::Timing3dRow>,
 }
 
 impl SessionData {
@@ -106,6 +108,7 @@ fn session_data(
         calibration: read(t, tables::CALIBRATION, &label)?,
         session,
         view,
+        timing: read(t, tables::TIMING_3D, &label)?,
     })
 }
 

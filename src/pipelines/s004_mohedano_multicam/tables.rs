@@ -12,6 +12,8 @@ pub(crate) const HEAD_CENTROID: &str = "head_centroid";
 pub(crate) const CAMERAS: &str = "cameras";
 pub(crate) const DETECTIONS_2D: &str = "detections_2d";
 pub(crate) const VARIANTS: &str = "variants";
+/// MEASURED: seconds of the 3-D stage per frame (main run); left out by tools/compare_out.py.
+pub(crate) const TIMING_3D: &str = "timing_3d";
 pub(crate) const SESSION: &str = "session";
 /// The camera images at the frame the camera-view figure shows (`report::columns::image_table`).
 pub(crate) const VIEW_IMAGE: &str = "view_image";
@@ -121,6 +123,19 @@ table_row! {
         pub pruned_frames: i64,
         pub promoted: i64,
         pub discarded: i64,
+    }
+}
+
+table_row! {
+    /// One frame of the main run's 3-D stage, timed (fastest of 3 steps on tracker clones).
+    #[derive(Debug, Clone, PartialEq)]
+    pub(crate) struct Timing3dRow {
+        pub detector: String,
+        pub association: String,
+        pub cameras: i64,
+        pub frame: i64,
+        pub objects_2d: i64,
+        pub seconds: f64,
     }
 }
 

@@ -48,7 +48,10 @@ pub(crate) fn cylinder_box(
     Some(b)
 }
 
-fn objects_for(views: &[CalibratedView], people: &[(u32, f64, f64, f64, f64)]) -> Vec<Object2d> {
+pub(crate) fn objects_for(
+    views: &[CalibratedView],
+    people: &[(u32, f64, f64, f64, f64)],
+) -> Vec<Object2d> {
     let mut out = Vec::new();
     for (c, v) in views.iter().enumerate() {
         for &(id, x, y, h, r) in people {
@@ -59,6 +62,7 @@ fn objects_for(views: &[CalibratedView], people: &[(u32, f64, f64, f64, f64)]) -
                 id: id + 10 * c as u32,
                 head_px: [head.x, head.y],
                 width_px: b[2] - b[0],
+                foot_px: Some([(b[0] + b[2]) / 2.0, b[3]]),
             });
         }
     }

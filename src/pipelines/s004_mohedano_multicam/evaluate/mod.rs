@@ -1,5 +1,5 @@
 //! The evaluation, one file per sub-experiment, each with its tables (and figures where it
-//! has one): `tracks`, `clear_mot` (CLEAR MOT / IDF1 / HOTA at each threshold), `gt_boxes`
+//! has one): `tracks`, `clear_mot` (CLEAR MOT / IDF1 / HOTA at each threshold), `moda` (MODA / MODP), `gt_boxes`
 //! (the 3-D stage on ground-truth boxes), `position` (position, height and radius errors),
 //! `sweep` (`N_app` against latency and false alarms), `head_centroid` (t-test),
 //! `selection` (E_c vs E_m), `stages` (per-camera image stages), `detections_2d` (the
@@ -10,11 +10,13 @@ mod clear_mot;
 mod detections_2d;
 mod gt_boxes;
 mod head_centroid;
+mod moda;
 mod position;
 mod search;
 mod selection;
 mod stages;
 mod sweep;
+mod timing;
 mod tracks;
 
 use super::Params;
@@ -27,6 +29,7 @@ pub(crate) fn evaluate(s: &Scored, p: &Params, products: &mut Products) -> anyho
     products.tables.push(tracks::table(s)?);
     if s.has_truth() {
         products.tables.push(clear_mot::table(s, p)?);
+        products.tables.push(moda::table(s)?);
         if let Some(t) = gt_boxes::table(s, &mut products.summary)? {
             products.tables.push(t);
         }
@@ -52,6 +55,7 @@ pub(crate) fn evaluate(s: &Scored, p: &Params, products: &mut Products) -> anyho
         products.tables.push(t);
     }
     products.tables.push(search::table(s)?);
+    products.tables.push(timing::table(s)?);
     Ok(())
 }
 

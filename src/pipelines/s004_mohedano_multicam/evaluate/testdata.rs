@@ -89,6 +89,7 @@ pub(crate) fn session() -> SessionData {
         detections_2d: Vec::new(),
         variants: Vec::new(),
         calibration: Vec::new(),
+        timing: Vec::new(),
         session: SessionRow {
             frames: FRAMES,
             cameras: 2,

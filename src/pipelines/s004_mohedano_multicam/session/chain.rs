@@ -161,6 +161,7 @@ impl CameraChain {
                 id: o.id,
                 head_px: o.head_px,
                 width_px: o.width_px,
+                foot_px: Some([(o.bbox[0] + o.bbox[2]) / 2.0, o.bbox[3]]),
             })
             .collect();
         out

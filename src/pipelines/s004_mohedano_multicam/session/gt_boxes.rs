@@ -54,6 +54,7 @@ pub(crate) fn gt_box_run(
                 id: o.id,
                 head_px: o.head_px,
                 width_px: o.width_px,
+                foot_px: Some([(o.bbox[0] + o.bbox[2]) / 2.0, o.bbox[3]]),
             }));
         }
         run.objects.push(objs);

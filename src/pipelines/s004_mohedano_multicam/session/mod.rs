@@ -123,6 +123,12 @@ pub(crate) fn process(
     }
     bar.set_message("3-D");
     let runs = runs::run_all(p, &views, dt_s, &sources, frames)?;
+    bar.set_message("3-D timing");
+    let timing = runs::time_run(
+        &views,
+        runs::cylinder_params(p, dt_s, p.selection, p.n_app),
+        &sources[0].1,
+    )?;
     bar.inc(1);
 
     let scores = Scores {
@@ -155,6 +161,19 @@ pub(crate) fn process(
         tables::Det2dRow::frame(&scores.detections_2d(frames, &gt_for_frame))?,
     );
     put(tables::VARIANTS, tables::VariantRow::frame(&runs.variants)?);
+    let timing_rows: Vec<tables::Timing3dRow> = timing
+        .iter()
+        .enumerate()
+        .map(|(k, &(n, s))| tables::Timing3dRow {
+            detector: main_detector(p).to_string(),
+            association: format!("{:?}", p.association).to_lowercase(),
+            cameras: views.len() as i64,
+            frame: k as i64,
+            objects_2d: n as i64,
+            seconds: s,
+        })
+        .collect();
+    put(tables::TIMING_3D, tables::Timing3dRow::frame(&timing_rows)?);
     put(
         tables::SESSION,
         SessionRow::frame(&[session_row(&pass, dt_s, p)])?,

@@ -29,6 +29,8 @@ pub(crate) fn cylinder_params(
         room_margin_m: p.room_margin_m,
         gate_m: p.gate_m,
         max_combinations: p.max_combinations,
+        association: p.association,
+        ground_separation_m: p.ground_separation_m,
         dt_s,
         ..CylinderParams::default()
     }
@@ -87,6 +89,31 @@ pub(crate) fn variants(p: &Params, sources: usize) -> Vec<(usize, Selection, u32
         out.push((si, other, p.n_app));
     }
     out
+}
+
+/// The main run's 3-D stage timed frame by frame (MEASURED): `(2-D objects, seconds)`, each
+/// frame the fastest of 3 steps on clones of the tracker (the clone is not timed); the real
+/// tracker then steps once, so the states are those of the run.
+pub(crate) fn time_run(
+    views: &[CalibratedView],
+    params: CylinderParams,
+    frames: &[Vec<Object2d>],
+) -> anyhow::Result<Vec<(usize, f64)>> {
+    let mut tracker = CylinderTracker::new(views.to_vec(), params)?;
+    let mut out = Vec::with_capacity(frames.len());
+    for objs in frames {
+        let mut best = f64::INFINITY;
+        for _ in 0..3 {
+            let mut t = tracker.clone();
+            let start = std::time::Instant::now();
+            let r = t.step(objs);
+            best = best.min(start.elapsed().as_secs_f64());
+            std::hint::black_box(r);
+        }
+        tracker.step(objs);
+        out.push((objs.len(), best));
+    }
+    Ok(out)
 }
 
 /// The rows of every run.

@@ -1,0 +1,82 @@
+//! `peopletrack import wildtrack DIR -o FILE.mcap`: a public dataset as a session log
+//! ([`peopletrack::log::import`]).
+
+use std::path::PathBuf;
+
+use peopletrack::log::import::wildtrack::{self, Intrinsics};
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    pub dataset: Dataset,
+}
+
+#[derive(Debug, clap::Subcommand)]
+pub enum Dataset {
+    /// WILDTRACK (7 calibrated cameras, annotated boxes and ground positions): DIR holds
+    /// `calibrations/` and `annotations_positions/`.
+    Wildtrack {
+        /// The dataset folder, e.g. ../shared/real/wildtrack.
+        dir: PathBuf,
+        /// The session log to write.
+        #[arg(short = 'o', long = "out", value_name = "FILE.mcap")]
+        out: PathBuf,
+        /// Use `intrinsic_original` (raw-video distortion) instead of `intrinsic_zero` (the
+        /// undistorted images the boxes were annotated on).
+        #[arg(long)]
+        original_intrinsics: bool,
+    },
+}
+
+pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
+    match &a.dataset {
+        Dataset::Wildtrack {
+            dir,
+            out: file,
+            original_intrinsics,
+        } => {
+            let intr = if *original_intrinsics {
+                Intrinsics::Original
+            } else {
+                Intrinsics::Zero
+            };
+            // which intrinsics the boxes fit: measured on both sets, printed for the user
+            for check in [Intrinsics::Zero, Intrinsics::Original] {
+                let ds = wildtrack::read(dir, check)?;
+                let c = wildtrack::projection_check(&ds);
+                writeln!(
+                    out,
+                    "{}: {} boxes; ground point to box bottom: median {:.1} px (p90 {:.1}); \
+                     {:.1} m above it to box top: median {:.1} px",
+                    check.folder(),
+                    c.boxes,
+                    c.median_foot_px,
+                    c.p90_foot_px,
+                    wildtrack::NOMINAL_HEIGHT_M,
+                    c.median_head_px
+                )?;
+            }
+            let ds = wildtrack::read(dir, intr)?;
+            if ds.skipped > 0 {
+                writeln!(
+                    out,
+                    "skipped {} people: {}",
+                    ds.skipped,
+                    ds.first_skip.as_deref().unwrap_or("")
+                )?;
+            }
+            let s = wildtrack::write(&ds, dir, intr, file)?;
+            writeln!(
+                out,
+                "{}: {} frames, {} person-frames, {} boxes in 7 cameras ({}; {} views not visible)",
+                s.path.display(),
+                s.frames,
+                s.people_frames,
+                s.boxes,
+                intr.folder(),
+                ds.invisible_views
+            )?;
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,41 @@
+//! Importers: public multi-camera datasets written as session logs in the project's log
+//! contract (`CameraInfo`, `/tf_static`, `vision_msgs/msg/Detection2DArray` per camera and the
+//! `/ground_truth/people` JSON of [`crate::groundtruth`]), so that the pipelines read them like
+//! any other log. Each importer is a pure reading of the dataset's files into typed parts plus
+//! one writing step through [`super::SessionWriter`] (atomic: scratch file + rename).
+//!
+//! - [`wildtrack`]: WILDTRACK (Chavdarova et al. 2018): 7 calibrated HD cameras, annotated
+//!   boxes and ground positions.
+
+pub mod wildtrack;
+
+/// Why an import failed; every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum ImportError {
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("{path}: {reason}")]
+    Parse { path: String, reason: String },
+    #[error("{0}")]
+    Log(#[from] super::LogError),
+}
+
+impl ImportError {
+    pub(crate) fn parse(path: &std::path::Path, reason: impl Into<String>) -> ImportError {
+        ImportError::Parse {
+            path: path.display().to_string(),
+            reason: reason.into(),
+        }
+    }
+}
+
+/// Read a whole text file (error naming it).
+pub(crate) fn read_text(path: &std::path::Path) -> Result<String, ImportError> {
+    std::fs::read_to_string(path).map_err(|source| ImportError::Io {
+        path: path.display().to_string(),
+        source,
+    })
+}
