@@ -129,7 +129,8 @@ fn decompress_and_copy(path: &Path) -> usize {
                 match compression {
                     b"" => chunk.extend_from_slice(records),
                     b"zstd" => {
-                        zstd.decompress_to_buffer(records, &mut chunk).expect("zstd");
+                        zstd.decompress_to_buffer(records, &mut chunk)
+                            .expect("zstd");
                     }
                     b"lz4" => {
                         use std::io::Read;
@@ -150,10 +151,18 @@ fn decompress_and_copy(path: &Path) -> usize {
 }
 
 fn rows(g: &mut criterion::BenchmarkGroup<'_, WallTime>, name: &str, p: &Path) {
-    assert_eq!(decode_all(p), decompress_and_copy(p), "{name}: same messages");
+    assert_eq!(
+        decode_all(p),
+        decompress_and_copy(p),
+        "{name}: same messages"
+    );
     g.bench_function(name, |b| b.iter(|| decode_all(p)));
-    g.bench_function(format!("{name}_dynamic"), |b| b.iter(|| decode_all_dynamic(p)));
-    g.bench_function(format!("{name}_limit"), |b| b.iter(|| decompress_and_copy(p)));
+    g.bench_function(format!("{name}_dynamic"), |b| {
+        b.iter(|| decode_all_dynamic(p))
+    });
+    g.bench_function(format!("{name}_limit"), |b| {
+        b.iter(|| decompress_and_copy(p))
+    });
 }
 
 fn bench(c: &mut Criterion) {

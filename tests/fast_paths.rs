@@ -84,7 +84,10 @@ fn real_logs_decode_the_same_by_the_fast_paths() {
             return;
         };
         let seen = compare_all(&path);
-        assert!(seen.get("laser_scan").copied().unwrap_or(0) > 0, "{name}: {seen:?}");
+        assert!(
+            seen.get("laser_scan").copied().unwrap_or(0) > 0,
+            "{name}: {seen:?}"
+        );
         for (kind, n) in counts {
             assert_eq!(seen.get(kind), Some(n), "{name}: {seen:?}");
         }

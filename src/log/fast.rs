@@ -81,9 +81,7 @@ impl FastKind {
                 .collect()
         });
         let root = reg.defs.get(reg.root)?;
-        let (kind, ours) = canonical
-            .iter()
-            .find(|(k, _)| k.type_name() == root.name)?;
+        let (kind, ours) = canonical.iter().find(|(k, _)| k.type_name() == root.name)?;
         definitions::same_layout(reg, reg.root, ours, ours.root).then_some(*kind)
     }
 }

@@ -414,7 +414,10 @@ mod tests {
             ("empty", Value::Struct(vec![])),
             (
                 "a",
-                Value::Array(vec![record([("x", Value::U16(7))]), Value::String("y".into())]),
+                Value::Array(vec![
+                    record([("x", Value::U16(7))]),
+                    Value::String("y".into()),
+                ]),
             ),
             ("bs", Value::Bools(vec![true, false])),
             ("by", Value::Bytes(vec![0, 255, 7])),
@@ -425,8 +428,14 @@ mod tests {
             ("u32s", Value::U32s(vec![u32::MAX, 0])),
             ("i64s", Value::I64s(vec![])),
             ("u64s", Value::U64s(vec![1, 2, 3])),
-            ("f32s", Value::F32s(vec![1.5, f32::NAN, f32::NEG_INFINITY, 3.4e38, 1e-45])),
-            ("f64s", Value::F64s(vec![0.1 + 0.2, f64::INFINITY, 123456789.0, 1e21])),
+            (
+                "f32s",
+                Value::F32s(vec![1.5, f32::NAN, f32::NEG_INFINITY, 3.4e38, 1e-45]),
+            ),
+            (
+                "f64s",
+                Value::F64s(vec![0.1 + 0.2, f64::INFINITY, 123456789.0, 1e21]),
+            ),
         ]);
         for max in [None, Some(0), Some(1), Some(2), Some(100)] {
             same_text(&v, max);

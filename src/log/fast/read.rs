@@ -5,8 +5,8 @@ use std::borrow::Cow;
 use nalgebra::{Point3, Quaternion, Vector3};
 
 use super::super::msgs::{
-    CameraInfo, CompressedImage, Header, Image, Imu, LaserScan, Odometry, Pose, TfMessage, Time, Transform,
-    TransformStamped,
+    CameraInfo, CompressedImage, Header, Image, Imu, LaserScan, Odometry, Pose, TfMessage, Time,
+    Transform, TransformStamped,
 };
 use super::{Cursor, FastCdr, FastKind, Result, prefixed, within};
 
@@ -159,7 +159,10 @@ impl FastCdr for CameraInfo {
         within(header_into(c, &mut self.header), "header")?;
         self.height = within(c.u32(), "height")?;
         self.width = within(c.u32(), "width")?;
-        within(c.string_into(&mut self.distortion_model), "distortion_model")?;
+        within(
+            c.string_into(&mut self.distortion_model),
+            "distortion_model",
+        )?;
         within(c.f64_seq(&mut self.d), "d")?;
         within(c.f64_array(&mut self.k), "k")?;
         within(c.f64_array(&mut self.r), "r")?;

@@ -88,7 +88,11 @@ fn generic<T: RosMessage>(data: &[u8]) -> std::result::Result<T, String> {
 /// for both (never a panic).
 fn agrees<T: RosMessage + FastCdr + Default + PartialEq + std::fmt::Debug>(data: &[u8]) -> T {
     let fast: T = decode(data).expect("fast path decodes");
-    assert_eq!(Ok(&fast), generic::<T>(data).as_ref(), "fast path = dynamic decoder");
+    assert_eq!(
+        Ok(&fast),
+        generic::<T>(data).as_ref(),
+        "fast path = dynamic decoder"
+    );
     for cut in 0..data.len() {
         assert!(decode::<T>(&data[..cut]).is_err(), "prefix of {cut} bytes");
         assert!(generic::<T>(&data[..cut]).is_err(), "prefix of {cut} bytes");
@@ -133,7 +137,10 @@ fn tf_known_answer_in_every_byte_order_and_alignment() {
         assert_eq!(tf.transforms.len(), 2);
         let t = &tf.transforms[0];
         assert_eq!((t.header.stamp.sec, t.header.stamp.nanosec), (7, 9));
-        assert_eq!((t.header.frame_id.as_str(), t.child_frame_id.as_str()), ("odom", "base1"));
+        assert_eq!(
+            (t.header.frame_id.as_str(), t.child_frame_id.as_str()),
+            ("odom", "base1")
+        );
         assert_eq!(t.transform.translation, Vector3::new(1.0, 2.0, 3.0));
         assert_eq!(t.transform.rotation.w, 1.0);
         assert_eq!(tf.transforms[1].header.stamp.sec, -1);
@@ -206,7 +213,9 @@ fn camera_info_with_empty_and_full_distortion() {
             w.u32(d.len() as u32).f64s(d);
             w.f64s(&[500.0, 0.0, 320.0, 0.0, 500.0, 240.0, 0.0, 0.0, 1.0]);
             w.f64s(&[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
-            w.f64s(&[500.0, 0.0, 320.0, 0.0, 0.0, 500.0, 240.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
+            w.f64s(&[
+                500.0, 0.0, 320.0, 0.0, 0.0, 500.0, 240.0, 0.0, 0.0, 0.0, 1.0, 0.0,
+            ]);
             w.u32(2).u32(3).u32(10).u32(20).u32(100).u32(200).u8(1);
             let ci: CameraInfo = agrees(&w.buf);
             assert_eq!(ci.d, d);
@@ -221,7 +230,12 @@ fn camera_info_with_empty_and_full_distortion() {
 fn images_borrow_their_pixels_from_the_payload() {
     for (big, a) in ENCODINGS {
         let mut w = W::new(big, a);
-        w.header(8, 9, b"cam_0").u32(2).u32(3).str(b"rgb8").u8(0).u32(9);
+        w.header(8, 9, b"cam_0")
+            .u32(2)
+            .u32(3)
+            .str(b"rgb8")
+            .u8(0)
+            .u32(9);
         w.u32(18);
         w.buf.extend(0..18u8);
         let owned: Image = agrees(&w.buf);
@@ -265,7 +279,10 @@ fn hostile_lengths_are_errors_before_any_allocation() {
     w.header(0, 0, b"").str(b"x").u32(1 << 30);
     let e = decode::<CompressedImage>(&w.buf).expect_err("too long");
     assert_eq!(e.path, "data");
-    assert!(Cursor::new(&[0x00, 0x02, 0, 0]).is_err(), "parameter list refused");
+    assert!(
+        Cursor::new(&[0x00, 0x02, 0, 0]).is_err(),
+        "parameter list refused"
+    );
 }
 
 #[test]
