@@ -31,7 +31,7 @@ pub struct Args {
     pub out: PathBuf,
     /// Write the tracks back into a copy of each log (as visualization_msgs/msg/MarkerArray,
     /// for Foxglove) under DIR (default: <out>/tracks), for pipelines that produce tracks.
-    /// (Given without DIR it is `Some(None)`: a path value parser rejects an empty default.)
+    // Given without DIR it is `Some(None)`: a path value parser rejects an empty default.
     #[arg(long, value_name = "DIR", num_args = 0..=1)]
     pub write_tracks: Option<Option<PathBuf>>,
 }
