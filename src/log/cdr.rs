@@ -122,8 +122,10 @@ impl CdrError {
 
 type Result<T> = std::result::Result<T, CdrError>;
 
+mod cursor;
 mod encode;
 
+pub use cursor::Cursor;
 pub use encode::{default_value, encode, literal_value};
 
 /// Parse the encapsulation header: byte order and maximum alignment.
@@ -143,12 +145,8 @@ fn encapsulation(data: &[u8]) -> Result<(Endian, usize)> {
 
 /// Decode one CDR message of the registry's root type.
 pub fn decode(registry: &Registry, data: &[u8]) -> Result<Value> {
-    let (endian, max_align) = encapsulation(data)?;
     let mut reader = Reader {
-        buf: &data[4..],
-        pos: 0,
-        big: endian == Endian::Big,
-        max_align,
+        cur: Cursor::new(data)?,
         depth: 0,
         budget: tree_budget(data.len()),
     };
@@ -156,102 +154,36 @@ pub fn decode(registry: &Registry, data: &[u8]) -> Result<Value> {
 }
 
 struct Reader<'a> {
-    buf: &'a [u8],
-    pos: usize,
-    big: bool,
-    max_align: usize,
+    cur: Cursor<'a>,
     /// Message types entered and not yet left.
     depth: usize,
     /// Bytes of tree structure still allowed ([`tree_budget`]).
     budget: usize,
 }
 
-macro_rules! read_scalar {
-    ($name:ident, $t:ty) => {
-        fn $name(&mut self) -> Result<$t> {
-            const N: usize = std::mem::size_of::<$t>();
-            self.align(N);
-            let b: [u8; N] = self.take(N)?.try_into().expect("take returns N bytes");
-            Ok(if self.big {
-                <$t>::from_be_bytes(b)
-            } else {
-                <$t>::from_le_bytes(b)
-            })
-        }
-    };
-}
-
 macro_rules! read_packed {
     ($self:ident, $n:ident, $t:ty, $variant:ident) => {{
         const N: usize = std::mem::size_of::<$t>();
-        if $n > 0 {
-            $self.align(N);
-        }
-        let bytes = $self.take($self.len_bytes($n, N)?)?;
-        let v: Vec<$t> = if $self.big {
-            bytes
-                .chunks_exact(N)
-                .map(|c| <$t>::from_be_bytes(c.try_into().expect("chunk of N")))
-                .collect()
-        } else {
-            bytes
-                .chunks_exact(N)
-                .map(|c| <$t>::from_le_bytes(c.try_into().expect("chunk of N")))
-                .collect()
-        };
+        let big = $self.cur.is_big_endian();
+        let v: Vec<$t> = $self
+            .cur
+            .packed($n, N)?
+            .as_chunks::<N>()
+            .0
+            .iter()
+            .map(|&c| {
+                if big {
+                    <$t>::from_be_bytes(c)
+                } else {
+                    <$t>::from_le_bytes(c)
+                }
+            })
+            .collect();
         Value::$variant(v)
     }};
 }
 
 impl<'a> Reader<'a> {
-    fn align(&mut self, size: usize) {
-        let a = size.min(self.max_align);
-        let rem = self.pos % a;
-        if rem != 0 {
-            self.pos += a - rem;
-        }
-    }
-
-    fn take(&mut self, n: usize) -> Result<&'a [u8]> {
-        let have = self.buf.len().saturating_sub(self.pos);
-        if n > have {
-            return Err(CdrError::new(CdrErrorKind::UnexpectedEnd {
-                offset: self.pos + 4,
-                need: n,
-                have,
-            }));
-        }
-        let out = &self.buf[self.pos..self.pos + n];
-        self.pos += n;
-        Ok(out)
-    }
-
-    read_scalar!(u16, u16);
-    read_scalar!(i16, i16);
-    read_scalar!(u32, u32);
-    read_scalar!(i32, i32);
-    read_scalar!(u64, u64);
-    read_scalar!(i64, i64);
-    read_scalar!(f32, f32);
-    read_scalar!(f64, f64);
-
-    fn u8(&mut self) -> Result<u8> {
-        Ok(self.take(1)?[0])
-    }
-
-    /// Bytes that `n` elements of `size` bytes take, if the payload has that many left.
-    fn len_bytes(&self, n: usize, size: usize) -> Result<usize> {
-        let remaining = self.buf.len().saturating_sub(self.pos);
-        match n.checked_mul(size) {
-            Some(need) if need <= remaining => Ok(need),
-            _ => Err(CdrError::new(CdrErrorKind::LengthTooLarge {
-                offset: self.pos + 4,
-                len: n as u64,
-                remaining,
-            })),
-        }
-    }
-
     /// Check an array or sequence length before anything is allocated for it: its elements
     /// must fit in the bytes left (`min_elem_size` each), or, when they take no bytes at all,
     /// be at most [`MAX_ZERO_SIZE_ELEMENTS`]; `slot` bytes of tree structure are charged per
@@ -260,7 +192,7 @@ impl<'a> Reader<'a> {
         if min_elem_size == 0 && n > MAX_ZERO_SIZE_ELEMENTS {
             return Err(CdrError::new(CdrErrorKind::TooManyEmpty { len: n as u64 }));
         }
-        self.len_bytes(n, min_elem_size)?;
+        self.cur.check_fits(n, min_elem_size)?;
         self.charge(n.saturating_mul(slot))?;
         Ok(n)
     }
@@ -268,8 +200,8 @@ impl<'a> Reader<'a> {
     fn charge(&mut self, bytes: usize) -> Result<()> {
         self.budget = self.budget.checked_sub(bytes).ok_or_else(|| {
             CdrError::new(CdrErrorKind::TreeTooLarge {
-                budget: tree_budget(self.buf.len() + 4),
-                payload: self.buf.len() + 4,
+                budget: tree_budget(self.cur.payload_len()),
+                payload: self.cur.payload_len(),
             })
         })?;
         Ok(())
@@ -277,13 +209,13 @@ impl<'a> Reader<'a> {
 
     /// A sequence length prefix, checked like [`Reader::check_len`].
     fn seq_len(&mut self, min_elem_size: usize, slot: usize) -> Result<usize> {
-        let len = self.u32()? as usize;
+        let len = self.cur.u32()? as usize;
         self.check_len(len, min_elem_size, slot)
     }
 
     fn string(&mut self) -> Result<String> {
         let len = self.seq_len(1, 0)?;
-        let bytes = self.take(len)?;
+        let bytes = self.cur.take(len)?;
         // length counts the NUL terminator; tolerate writers that omit it
         let bytes = bytes.strip_suffix(&[0]).unwrap_or(bytes);
         Ok(String::from_utf8_lossy(bytes).into_owned())
@@ -293,7 +225,7 @@ impl<'a> Reader<'a> {
         let len = self.seq_len(4, 0)?;
         let mut s = String::with_capacity(len);
         for _ in 0..len {
-            let unit = self.u32()?;
+            let unit = self.cur.u32()?;
             s.push(char::from_u32(unit).unwrap_or(char::REPLACEMENT_CHARACTER));
         }
         Ok(s)
@@ -315,7 +247,7 @@ impl<'a> Reader<'a> {
             .get(idx)
             .ok_or(CdrError::new(CdrErrorKind::TooDeep))?;
         if def.fields.is_empty() {
-            self.u8()?;
+            self.cur.u8()?;
             return Ok(Value::Struct(Vec::new()));
         }
         self.charge(def.fields.len() * std::mem::size_of::<(Arc<str>, Value)>())?;
@@ -344,17 +276,17 @@ impl<'a> Reader<'a> {
     fn read_single(&mut self, reg: &Registry, ty: &BaseType) -> Result<Value> {
         Ok(match ty {
             BaseType::Prim(p) => match p {
-                Prim::Bool => Value::Bool(self.u8()? != 0),
-                Prim::Byte | Prim::Char | Prim::U8 => Value::U8(self.u8()?),
-                Prim::I8 => Value::I8(self.u8()? as i8),
-                Prim::I16 => Value::I16(self.i16()?),
-                Prim::U16 => Value::U16(self.u16()?),
-                Prim::I32 => Value::I32(self.i32()?),
-                Prim::U32 => Value::U32(self.u32()?),
-                Prim::I64 => Value::I64(self.i64()?),
-                Prim::U64 => Value::U64(self.u64()?),
-                Prim::F32 => Value::F32(self.f32()?),
-                Prim::F64 => Value::F64(self.f64()?),
+                Prim::Bool => Value::Bool(self.cur.u8()? != 0),
+                Prim::Byte | Prim::Char | Prim::U8 => Value::U8(self.cur.u8()?),
+                Prim::I8 => Value::I8(self.cur.u8()? as i8),
+                Prim::I16 => Value::I16(self.cur.i16()?),
+                Prim::U16 => Value::U16(self.cur.u16()?),
+                Prim::I32 => Value::I32(self.cur.i32()?),
+                Prim::U32 => Value::U32(self.cur.u32()?),
+                Prim::I64 => Value::I64(self.cur.i64()?),
+                Prim::U64 => Value::U64(self.cur.u64()?),
+                Prim::F32 => Value::F32(self.cur.f32()?),
+                Prim::F64 => Value::F64(self.cur.f64()?),
             },
             BaseType::String { .. } => Value::String(self.string()?),
             BaseType::WString { .. } => Value::String(self.wstring()?),
@@ -365,9 +297,9 @@ impl<'a> Reader<'a> {
     fn read_array(&mut self, reg: &Registry, ty: &BaseType, n: usize) -> Result<Value> {
         Ok(match ty {
             BaseType::Prim(p) => match p {
-                Prim::Bool => Value::Bools(self.take(n)?.iter().map(|b| *b != 0).collect()),
-                Prim::Byte | Prim::Char | Prim::U8 => Value::Bytes(self.take(n)?.to_vec()),
-                Prim::I8 => Value::I8s(self.take(n)?.iter().map(|b| *b as i8).collect()),
+                Prim::Bool => Value::Bools(self.cur.take(n)?.iter().map(|b| *b != 0).collect()),
+                Prim::Byte | Prim::Char | Prim::U8 => Value::Bytes(self.cur.take(n)?.to_vec()),
+                Prim::I8 => Value::I8s(self.cur.take(n)?.iter().map(|b| *b as i8).collect()),
                 Prim::I16 => read_packed!(self, n, i16, I16s),
                 Prim::U16 => read_packed!(self, n, u16, U16s),
                 Prim::I32 => read_packed!(self, n, i32, I32s),

@@ -15,7 +15,7 @@ use super::{Cursor, FastCdr, FastKind, Result, prefixed, within};
 const MIN_TRANSFORM_STAMPED: usize = 72;
 
 fn header_into(c: &mut Cursor<'_>, h: &mut Header) -> Result<()> {
-    h.stamp = within(c.time(), "stamp")?;
+    h.stamp = within(time(c), "stamp")?;
     within(c.string_into(&mut h.frame_id), "frame_id")
 }
 
@@ -194,7 +194,7 @@ pub struct HeaderRef<'a> {
 impl<'a> HeaderRef<'a> {
     fn read(c: &mut Cursor<'a>) -> Result<Self> {
         Ok(HeaderRef {
-            stamp: within(c.time(), "stamp")?,
+            stamp: within(time(c), "stamp")?,
             frame_id: within(c.str(), "frame_id")?,
         })
     }
@@ -301,4 +301,12 @@ impl FastCdr for CompressedImage {
         bytes_from(&mut self.data, r.data);
         Ok(())
     }
+}
+
+/// `builtin_interfaces/msg/Time`.
+fn time(c: &mut Cursor<'_>) -> Result<Time> {
+    Ok(Time {
+        sec: c.i32()?,
+        nanosec: c.u32()?,
+    })
 }
