@@ -27,6 +27,7 @@ fn dry_run(out: &Path) -> RunOptions {
         git_commit: "test".into(),
         progress: None,
         write_tracks: None,
+        recover: false,
     }
 }
 

@@ -328,8 +328,29 @@ fn message_before_its_chunks_declared_start_is_never_delivered_out_of_order() {
         "0.000000040 s",
         "0.000000020 s",
         "lies",
+        "cat --recover",
     ] {
         assert!(msg.contains(needle), "`{needle}` missing from: {msg}");
+    }
+    // the fallback the error names: index from the data (`run` does this by itself)
+    for log in [
+        SessionLog::open_scanning(&p).expect("scans"),
+        SessionLog::open_recovering(&p).expect("recovers"),
+    ] {
+        let times: Vec<u64> = log
+            .messages()
+            .expect("stream")
+            .map(|m| m.expect("message").log_time.0)
+            .collect();
+        assert_eq!(times, [0, 20, 30, 100]);
+        assert!(
+            log.summary()
+                .warnings
+                .iter()
+                .any(|w| w.contains(&format!("chunk at byte {b_at} declares"))),
+            "{:?}",
+            log.summary().warnings
+        );
     }
     // without the summary the linear pass learns each chunk's real range: right order
     let p = dir.path().join("lying_header.mcap");

@@ -183,6 +183,7 @@ fn options(out: &Path, sessions: Vec<String>) -> RunOptions {
         git_commit: String::new(),
         progress: None,
         write_tracks: None,
+        recover: false,
     }
 }
 

@@ -20,6 +20,7 @@ fn opts(out: &Path) -> RunOptions {
         git_commit: "test".into(),
         progress: None,
         write_tracks: None,
+        recover: false,
     }
 }
 

@@ -93,6 +93,7 @@ fn options(out: &Path) -> RunOptions {
         git_commit: "test".into(),
         progress: None,
         write_tracks: None,
+        recover: false,
     }
 }
 

@@ -93,6 +93,7 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         git_commit: super::git_commit(),
         progress: super::progress::shared(super::stderr_is_terminal()),
         write_tracks: None,
+        recover: false,
     };
     let mut runs = Vec::new();
     for f in &files {
@@ -114,6 +115,12 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         )?;
         for (session, why) in &s.skipped {
             eprintln!("warning: {}: skipped {session}: {why}", s.pipeline);
+        }
+        for (session, why) in &s.warned {
+            eprintln!(
+                "warning: {}: {session} read with warnings (results kept): {why}",
+                s.pipeline
+            );
         }
         runs.push(s);
     }

@@ -34,6 +34,12 @@ pub struct Args {
     // Given without DIR it is `Some(None)`: a path value parser rejects an empty default.
     #[arg(long, value_name = "DIR", num_args = 0..=1)]
     pub write_tracks: Option<Option<PathBuf>>,
+    /// Read damaged logs as far as they go, as `cat --recover` does: every complete chunk
+    /// before the damage (and good chunks after a bad one); each session read so is listed
+    /// with what was lost (bytes, time span, topics) in the `skipped_sessions` table and the
+    /// report, its results kept.
+    #[arg(long)]
+    pub recover: bool,
 }
 
 fn parse_shard(s: &str) -> Result<(usize, usize), String> {
@@ -62,6 +68,7 @@ pub fn options(a: &Args, progress: bool) -> RunOptions {
             .write_tracks
             .as_ref()
             .map(|d| d.clone().unwrap_or_else(|| a.out.join("tracks"))),
+        recover: a.recover,
     }
 }
 
@@ -93,6 +100,9 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     }
     for (session, why) in &s.skipped {
         eprintln!("warning: skipped {session}: {why}");
+    }
+    for (session, why) in &s.warned {
+        eprintln!("warning: {session} read with warnings (results kept): {why}");
     }
     Ok(())
 }

@@ -126,6 +126,7 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         git_commit: super::git_commit(),
         progress: super::progress::shared(super::stderr_is_terminal()),
         write_tracks: None,
+        recover: false,
     };
     atomic::sweep_scratch(&a.out)?;
     let s = pipelines::run_file(&a.config, &opts)?;

@@ -67,7 +67,7 @@ pub enum LogErrorKind {
     )]
     NotTimeOrdered { previous: Nanos, this: Nanos },
     #[error(
-        "chunk at byte {offset} declares its messages start at {start} s but holds one at {this} s, before messages already read at {previous} s: the chunk index lies, so log-time order cannot be kept; rewrite the file with `mcap sort`"
+        "chunk at byte {offset} declares its messages start at {start} s but holds one at {this} s, before messages already read at {previous} s: the chunk index lies, so log-time order cannot be kept while trusting it; `peopletrack run` re-reads such a log with a linear scan of the data by itself, `cat --recover` does so too, or rewrite the file with `mcap sort`"
     )]
     ChunkStartsEarlier {
         offset: u64,

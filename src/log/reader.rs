@@ -116,6 +116,23 @@ impl SessionLog {
         Ok(SessionLog { path, summary })
     }
 
+    /// Open a log indexing it from the data alone: one linear pass that decompresses every
+    /// chunk and learns each chunk's real time range, ignoring the summary section. For a log
+    /// whose chunk index lies about time ranges ([`LogErrorKind::ChunkStartsEarlier`]), where
+    /// trusting the index cannot keep log-time order; what the pass found is said in
+    /// [`LogSummary::warnings`].
+    pub fn open_scanning(path: impl AsRef<Path>) -> Result<SessionLog, LogError> {
+        let (path, mut file, file_len) = open_mcap(path.as_ref())?;
+        let err = |k: LogErrorKind| LogError::new(&path, k);
+        let mut summary = index::linear_index(&mut file, file_len).map_err(err)?;
+        summary.warnings.insert(
+            0,
+            "indexed by a linear scan of the data (the chunk index's time ranges were not used)"
+                .to_string(),
+        );
+        Ok(SessionLog { path, summary })
+    }
+
     /// Open a damaged log (`--recover`): index it front to back, leaving out chunks that do
     /// not open and stopping where the file is cut or its records lose their framing. What
     /// was lost is said in [`LogSummary::warnings`]; the messages read are the complete ones

@@ -81,6 +81,7 @@ mod tests {
                 git_commit: String::new(),
                 progress: None,
                 write_tracks: None,
+                recover: false,
             };
             if let Err(e) = run_file(&path, &opts) {
                 let msg = format!("{e:#}");

@@ -18,6 +18,8 @@ use crate::report::{Provenance, atomic};
 
 const KEY_FILE: &str = "key.txt";
 const SOURCE_FILE: &str = "source.txt";
+/// The reading warnings of a session's log (recovery losses, a linear re-index), one per line.
+const WARNINGS_FILE: &str = "warnings.txt";
 
 /// Hash of a file's bytes (xxh3-128, streamed).
 pub fn hash_file(path: &Path) -> std::io::Result<u128> {
@@ -40,6 +42,8 @@ pub struct KeyParts<'a> {
     pub version: u32,
     pub params_json: &'a str,
     pub topics_json: &'a str,
+    /// `--recover`: results from a damaged log's readable part are cached apart.
+    pub recover: bool,
 }
 
 impl KeyParts<'_> {
@@ -52,6 +56,9 @@ impl KeyParts<'_> {
         h.update(&self.version.to_le_bytes());
         h.update(self.params_json.as_bytes());
         h.update(self.topics_json.as_bytes());
+        if self.recover {
+            h.update(b"recover");
+        }
         format!("{:032x}", h.digest128())
     }
 }
@@ -64,8 +71,8 @@ pub fn session_dir(out: &Path, pipeline: &str, s: &SessionRef) -> PathBuf {
         .join(&s.name)
 }
 
-/// Cached tables if the stored key is `key`.
-pub fn load(dir: &Path, key: &str) -> Option<SessionTables> {
+/// Cached tables and the log's reading warnings if the stored key is `key`.
+pub fn load(dir: &Path, key: &str) -> Option<(SessionTables, Vec<String>)> {
     let stored = std::fs::read_to_string(dir.join(KEY_FILE)).ok()?;
     if stored.trim() != key {
         return None;
@@ -78,7 +85,12 @@ pub fn load(dir: &Path, key: &str) -> Option<SessionTables> {
             tables.insert(name, read_parquet(&p).ok()?);
         }
     }
-    Some(tables)
+    let warnings = match std::fs::read_to_string(dir.join(WARNINGS_FILE)) {
+        Ok(text) => text.lines().map(str::to_string).collect(),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+        Err(_) => return None,
+    };
+    Some((tables, warnings))
 }
 
 /// The log hash recorded with a cached result (none for caches without `source.txt`).
@@ -93,7 +105,7 @@ pub fn store(
     dir: &Path,
     key: &str,
     source: (&Path, u128),
-    tables: &SessionTables,
+    (tables, warnings): (&SessionTables, &[String]),
     prov: &Provenance,
 ) -> anyhow::Result<()> {
     let tag = xxhash_rust::xxh3::xxh3_64(dir.to_string_lossy().as_bytes());
@@ -115,6 +127,11 @@ pub fn store(
         scratch.join(SOURCE_FILE),
         format!("{hash:032x}\n{}\n", path.display()),
     )?;
+    if !warnings.is_empty() {
+        // one line each: a warning never holds a newline (they are one-line messages)
+        let lines: Vec<String> = warnings.iter().map(|w| w.replace('\n', " ")).collect();
+        std::fs::write(scratch.join(WARNINGS_FILE), lines.join("\n") + "\n")?;
+    }
     std::fs::write(scratch.join(KEY_FILE), key)?;
     if dir.exists() {
         std::fs::remove_dir_all(dir)?;

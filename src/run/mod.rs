@@ -34,7 +34,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
-use crate::log::SessionLog;
+use crate::log::{LogError, LogErrorKind, SessionLog};
 use crate::progress::{Progress, SharedReporter, reporter};
 use crate::report::{Figure, Provenance, Table, atomic, table::write_table, write_figure};
 use config::{ConfigError, Invalid, PipelineFile, SessionRef};
@@ -139,6 +139,9 @@ pub struct RunOptions {
     pub progress: SharedReporter,
     /// Write tracks back into copies of the logs under this folder (`--write-tracks`).
     pub write_tracks: Option<PathBuf>,
+    /// Read damaged logs as far as they go (`--recover`): every complete chunk before the
+    /// damage (and good chunks after it); what was lost is listed per session.
+    pub recover: bool,
 }
 
 /// What a run did, for the report.
@@ -151,6 +154,9 @@ pub struct RunSummary {
     pub computed: usize,
     pub cached: usize,
     pub skipped: Vec<(String, String)>,
+    /// `(dataset/session, warnings)` of sessions that gave results but whose log needed
+    /// recovery (`--recover`) or a linear re-index (a chunk index that lies).
+    pub warned: Vec<(String, String)>,
     /// Path (relative to out/) of the `skipped_sessions` table's Markdown; empty when it was
     /// not written (dry runs, shards).
     pub skipped_table: String,
@@ -339,12 +345,19 @@ struct SessionJob<'a, P> {
     bars: &'a dyn crate::progress::Reporter,
 }
 
+/// One session's results: its tables, whether they came from the cache, and what reading
+/// its log warned about (losses under `--recover`, a linear re-index).
+struct SessionResult {
+    tables: SessionTables,
+    cached: bool,
+    warnings: Vec<String>,
+}
+
 /// Step 2, one session: its cached tables when the key matches, else `process` (then cached).
-/// Returns the tables and whether they came from the cache.
 fn session_tables<E: Experiment>(
     job: &SessionJob<E::Params>,
     s: &SessionRef,
-) -> anyhow::Result<(SessionTables, bool)> {
+) -> anyhow::Result<SessionResult> {
     let opts = job.opts;
     let dir = cache::session_dir(&opts.out, job.pipeline, s);
     let file_hash = if opts.aggregate_only && !s.path.exists() {
@@ -357,14 +370,52 @@ fn session_tables<E: Experiment>(
     };
     let key = job.key.key(file_hash);
     if !opts.force
-        && let Some(tables) = cache::load(&dir, &key)
+        && let Some((tables, warnings)) = cache::load(&dir, &key)
     {
-        return Ok((tables, true));
+        return Ok(SessionResult {
+            tables,
+            cached: true,
+            warnings,
+        });
     }
     if opts.aggregate_only {
         anyhow::bail!(skipped::NOT_CACHED);
     }
-    let log = SessionLog::open(&s.path)?;
+    let log = if opts.recover {
+        SessionLog::open_recovering(&s.path)?
+    } else {
+        SessionLog::open(&s.path)?
+    };
+    let (tables, log) = match process_log::<E>(job, s, log.clone()) {
+        // the index's time ranges lie: the data, scanned, decides the order
+        Err(e) if chunk_index_lies(&e) && !opts.recover => {
+            let log = SessionLog::open_scanning(&s.path)?;
+            (process_log::<E>(job, s, log.clone())?, log)
+        }
+        result => (result?, log),
+    };
+    let warnings = log.summary().warnings.clone();
+    cache::store(
+        &opts.out,
+        &dir,
+        &key,
+        (&s.path, file_hash),
+        (&tables, &warnings),
+        job.provenance,
+    )?;
+    Ok(SessionResult {
+        tables,
+        cached: false,
+        warnings,
+    })
+}
+
+/// The experiment's `process` on one opened log (a missing required topic is a skip).
+fn process_log<E: Experiment>(
+    job: &SessionJob<E::Params>,
+    s: &SessionRef,
+    log: SessionLog,
+) -> anyhow::Result<SessionTables> {
     let missing = missing_topics(&log, &job.plan.stages);
     if !missing.is_empty() {
         anyhow::bail!("{}{}", skipped::MISSING_TOPICS, missing.join(", "));
@@ -377,16 +428,17 @@ fn session_tables<E: Experiment>(
     let file = &job.plan.file;
     let tables = E::process(&session, &file.params, &file.topics, bar.as_ref());
     drop(bar);
-    let tables = tables?;
-    cache::store(
-        &opts.out,
-        &dir,
-        &key,
-        (&s.path, file_hash),
-        &tables,
-        job.provenance,
-    )?;
-    Ok((tables, false))
+    tables
+}
+
+/// Whether `e` comes from a chunk index whose time ranges lie
+/// ([`LogErrorKind::ChunkStartsEarlier`]): reading the log again by a linear scan of the data
+/// keeps log-time order.
+fn chunk_index_lies(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.downcast_ref::<LogError>()
+            .is_some_and(|l| matches!(*l.kind, LogErrorKind::ChunkStartsEarlier { .. }))
+    })
 }
 
 /// The text of a panic's payload.
@@ -400,8 +452,8 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
     }
 }
 
-/// One session's outcome: its tables and whether they were cached, or why it was skipped.
-type Outcome = Result<(SessionRef, SessionTables, bool), (SessionRef, String)>;
+/// One session's outcome: its results, or why it was skipped.
+type Outcome = Result<(SessionRef, SessionResult), (SessionRef, String)>;
 
 /// Step 2, every session (in parallel): a session that fails or panics becomes a skip with
 /// its reason; the others' results are kept. Outcomes come back in session order.
@@ -422,7 +474,7 @@ fn process_sessions<E: Experiment>(job: &SessionJob<E::Params>) -> Vec<Outcome> 
                 });
             total.inc(1);
             match outcome {
-                Ok((tables, cached)) => Ok((s.clone(), tables, cached)),
+                Ok(result) => Ok((s.clone(), result)),
                 Err(e) => Err((s.clone(), format!("{e:#}"))),
             }
         })
@@ -490,6 +542,7 @@ pub fn run_experiment<E: Experiment>(
         computed: 0,
         cached: 0,
         skipped: Vec::new(),
+        warned: Vec::new(),
         skipped_table: String::new(),
         tables: Vec::new(),
         figures: Vec::new(),
@@ -517,21 +570,30 @@ pub fn run_experiment<E: Experiment>(
             version: E::VERSION,
             params_json: &params_json,
             topics_json: &topics_json,
+            recover: opts.recover,
         },
         provenance: &provenance,
         bars: reporter(&opts.progress),
     };
     let mut done = Vec::new();
     let mut not_done = Vec::new();
+    let mut warned = Vec::new();
     for outcome in process_sessions::<E>(&job) {
         match outcome {
-            Ok((s, tables, cached)) => {
-                if cached {
+            Ok((s, result)) => {
+                if result.cached {
                     summary.cached += 1;
                 } else {
                     summary.computed += 1;
                 }
-                done.push((s, tables));
+                if !result.warnings.is_empty() {
+                    let why = result.warnings.join("; ");
+                    summary
+                        .warned
+                        .push((format!("{}/{}", s.dataset, s.name), why.clone()));
+                    warned.push((s.clone(), why));
+                }
+                done.push((s, result.tables));
             }
             Err((s, reason)) => {
                 summary
@@ -565,7 +627,7 @@ pub fn run_experiment<E: Experiment>(
         &file.params,
     )?;
     write_products(products, &opts.out, &provenance, &mut summary)?;
-    let skipped_table = skipped::table(&not_done, &provenance)?;
+    let skipped_table = skipped::table(&not_done, &warned, &provenance)?;
     write_table(
         &opts.out.join(&name).join("tables"),
         &skipped_table,

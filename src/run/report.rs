@@ -89,6 +89,16 @@ pub fn render(runs: &[RunSummary], tables_md: &BTreeMap<String, String>, h: &Hea
                 let status = super::skipped::status(why);
                 let _ = writeln!(o, "- `{s}` ({status}): {why}");
             }
+            if !r.warned.is_empty() {
+                let _ = writeln!(
+                    o,
+                    "\nRead with warnings ({}; their results are kept):\n",
+                    r.warned.len()
+                );
+                for (s, why) in &r.warned {
+                    let _ = writeln!(o, "- `{s}` ({}): {why}", super::skipped::WARNED);
+                }
+            }
             if !r.skipped_table.is_empty() {
                 let stem = r.skipped_table.trim_end_matches(".md");
                 let _ = writeln!(
@@ -133,6 +143,7 @@ mod tests {
                 ("lab/broken".into(), "file is truncated".into()),
                 ("lab/bug".into(), "panicked: index out of bounds".into()),
             ],
+            warned: vec![("lab/cut".into(), "file cut at byte 900".into())],
             skipped_table: "dataset_quality/tables/skipped_sessions.md".into(),
             tables: vec![(
                 "Sessions".into(),
@@ -161,6 +172,7 @@ mod tests {
         // a run without skips still says so, with its (empty) table
         let clean = RunSummary {
             skipped: Vec::new(),
+            warned: Vec::new(),
             ..run
         };
         let text = render(&[clean], &md, &h);
