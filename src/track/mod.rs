@@ -8,6 +8,8 @@
 //! - [`height_ekf`]: the (x, y, height) EKF of seed 002 §5 — laser range–bearing and camera
 //!   bearing + elevation updates, 3σ gate; a constant-velocity variant.
 //! - [`cylinders`]: multi-camera 3-D tracking of people as cylinders (seed 004 §5).
+//! - [`reid`]: Bayesian re-identification of people across local tracks (seed 003 §IV):
+//!   NIW kernels, the paper's spatio-temporal transition, assumed-density filtering.
 
 pub mod cylinders;
 pub mod graph_match;
@@ -15,3 +17,4 @@ pub mod height_ekf;
 pub mod jpda;
 pub mod kalman;
 pub mod position;
+pub mod reid;
