@@ -149,6 +149,16 @@ impl LocalRun {
         Ok(())
     }
 
+    /// The tracks' boxes of frame `frame` (the latest frame stepped).
+    pub fn frame_tracks(&self, frame: i64) -> &[TrackRow] {
+        let first = self
+            .tracks
+            .iter()
+            .rposition(|t| t.frame != frame)
+            .map_or(0, |i| i + 1);
+        &self.tracks[first..]
+    }
+
     /// The cached `tracks`, `gt_boxes` and `has_ground_truth` tables; the tracker's counters
     /// go to the session row.
     pub fn finish(

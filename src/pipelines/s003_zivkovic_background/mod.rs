@@ -40,6 +40,8 @@ mod colour_report;
 mod components;
 mod local_tracks;
 mod params;
+mod reid;
+mod reid_report;
 mod roc;
 mod session;
 mod shared;
@@ -49,7 +51,9 @@ mod wallflower;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-pub use params::{ColourParams, LocalEvalParams, Params, RocParams, WallflowerParams};
+pub use params::{
+    ClipParams, ColourParams, LocalEvalParams, Params, ReidParams, RocParams, WallflowerParams,
+};
 
 use crate::progress::Progress;
 use crate::run::config::Invalid;
@@ -62,7 +66,8 @@ impl Experiment for BackgroundTracking {
     // 2: EM-like stop rule (settled boundary), ROC datasets can be excluded
     // 3: timing = fastest of 3 runs per frame; standing/walking person pixels; cached tables
     //    from row structs, images as PNG
-    const VERSION: u32 = 4;
+    // 5: re-identification features (`reid_frames`) for `reid.datasets`
+    const VERSION: u32 = 5;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {
@@ -115,6 +120,7 @@ impl Experiment for BackgroundTracking {
         components::products(ctx, &mut products)?;
         colour_report::products(ctx, p, &mut products)?;
         local_tracks::products(ctx, p, &mut products)?;
+        reid_report::products(ctx, p, &mut products)?;
         wallflower::products(p, &mut products)?;
         Ok(products)
     }

@@ -133,6 +133,59 @@ impl Default for WallflowerParams {
     }
 }
 
+/// One clip of `[params.reid]`: the observations that ended by `until_s` (seconds since the
+/// session's first frame; absent: the whole session), as the paper's clips cover one or more
+/// places of the tour.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ClipParams {
+    pub name: String,
+    #[serde(default)]
+    pub until_s: Option<f64>,
+}
+
+/// `[params.reid]`: re-identification across local tracks (Zajdel et al., ICRA 2005).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ReidParams {
+    /// Datasets whose sessions are re-identified (a touring robot with several people).
+    pub datasets: Vec<String>,
+    /// Ground-truth boxes less visible than this are left out of the features.
+    pub min_visibility: f64,
+    /// A local track breaks where its person or track is unseen for longer than this (s).
+    pub max_gap_s: f64,
+    /// Local tracks with fewer frames than this are no observation.
+    pub min_frames: usize,
+    /// The nearest-neighbour baseline's distance threshold on the normalised 9-D feature.
+    pub nn_threshold: f64,
+    pub clips: Vec<ClipParams>,
+    /// Confidence level of the t-tests.
+    pub level: f64,
+}
+
+impl Default for ReidParams {
+    fn default() -> Self {
+        Self {
+            datasets: vec!["home_tour".into()],
+            min_visibility: 0.5,
+            max_gap_s: 1.0,
+            min_frames: 5,
+            nn_threshold: 0.15,
+            clips: vec![
+                ClipParams {
+                    name: "similar light".into(),
+                    until_s: Some(95.0),
+                },
+                ClipParams {
+                    name: "across light".into(),
+                    until_s: None,
+                },
+            ],
+            level: 0.95,
+        }
+    }
+}
+
 /// `[params]` of `pipelines/s003_zivkovic_background.toml`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -144,6 +197,7 @@ pub struct Params {
     pub local: LocalParams,
     pub local_eval: LocalEvalParams,
     pub wallflower: WallflowerParams,
+    pub reid: ReidParams,
 }
 
 impl Default for Params {
@@ -155,6 +209,7 @@ impl Default for Params {
             local: LocalParams::default(),
             local_eval: LocalEvalParams::default(),
             wallflower: WallflowerParams::default(),
+            reid: ReidParams::default(),
         }
     }
 }
@@ -217,6 +272,42 @@ fn local_problem(e: &LocalError) -> Invalid {
 }
 
 /// Every parameter problem, named by its key path below `[params]`.
+fn validate_reid(r: &ReidParams, bad: &mut impl FnMut(&str, String)) {
+    if !(0.0..=1.0).contains(&r.min_visibility) {
+        bad(
+            "reid.min_visibility",
+            format!("{} is not in [0, 1]", r.min_visibility),
+        );
+    }
+    for (key, v) in [
+        ("reid.max_gap_s", r.max_gap_s),
+        ("reid.nn_threshold", r.nn_threshold),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            bad(key, format!("{v} must be finite and positive"));
+        }
+    }
+    if r.min_frames == 0 {
+        bad("reid.min_frames", "must be at least 1".into());
+    }
+    if !(r.level > 0.0 && r.level < 1.0) {
+        bad("reid.level", format!("{} is not in (0, 1)", r.level));
+    }
+    if r.clips.is_empty() {
+        bad("reid.clips", "needs at least one clip".into());
+    }
+    for (i, c) in r.clips.iter().enumerate() {
+        if let Some(t) = c.until_s
+            && !(t.is_finite() && t > 0.0)
+        {
+            bad(
+                &format!("reid.clips[{i}].until_s"),
+                format!("{t} must be finite and > 0"),
+            );
+        }
+    }
+}
+
 pub(super) fn validate(p: &Params) -> Vec<Invalid> {
     let mut out: Vec<Invalid> = Vec::new();
     let mut bad = |k: &str, r: String| out.push((k.to_string(), r));
@@ -289,6 +380,7 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
             bad(key, format!("{v} must be finite and non-negative"));
         }
     }
+    validate_reid(&p.reid, &mut bad);
     if p.roc.fp_at_pct.iter().any(|v| !(0.0..=100.0).contains(v)) {
         bad(
             "roc.fp_at_pct",

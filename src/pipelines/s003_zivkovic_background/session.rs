@@ -11,6 +11,7 @@ use image::RgbImage;
 use super::colour::ColourRun;
 use super::local_tracks::LocalRun;
 use super::params::{LocalEvalParams, Params, topics_of};
+use super::reid::ReidRun;
 use super::roc::RocRun;
 use super::shared::{Frame, SESSION_TABLE, SessionRow, session_row};
 use super::timing::TimingRun;
@@ -95,6 +96,7 @@ pub(super) fn process(
         p.colour.datasets.contains(&s.info.dataset) && has_mask && !cx.ground_truth.is_empty();
     let mut colour = ColourRun::new(p, colour_wanted);
     let mut local = LocalRun::new(p)?;
+    let mut reid = ReidRun::new(p, &s.info.dataset);
     let mut first_stamp: Option<Nanos> = None;
     let mut frame_index: i64 = -1;
     let mut shape = (0u32, 0u32);
@@ -138,6 +140,7 @@ pub(super) fn process(
         }
         colour.step(&frame)?;
         local.step(&frame)?;
+        reid.step(&frame, local.frame_tracks(frame.index));
         last_rgb = Some(f.rgb);
     }
     let frames_without_mask = frames.frames_without_mask() as i64;
@@ -181,6 +184,7 @@ pub(super) fn process(
     }
     colour.finish(&mut out)?;
     local.finish(!cx.ground_truth.is_empty(), &mut row, &mut out)?;
+    reid.finish(&mut out)?;
     out.insert(SESSION_TABLE.into(), SessionRow::frame(&[row])?);
     Ok(out)
 }
