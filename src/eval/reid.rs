@@ -6,6 +6,7 @@
 //!   and the error in the number of distinct people.
 //! - Pairwise precision / recall / F1 over all pairs of observations ("same person?").
 //! - The adjusted Rand index (Hubert & Arabie 1985) from the contingency table.
+//! - Retrieval: rank-1 and mean average precision, each observation querying all the others.
 //!
 //! Pure functions of the two label lists; the order of observations does not matter.
 
@@ -106,9 +107,75 @@ pub fn score<T: Ord, L: Ord>(truth: &[T], labels: &[L]) -> ReidScores {
     }
 }
 
+/// Retrieval scores of a gallery: every observation queries all the others, ranked by
+/// Euclidean distance of their features (ties in observation order).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Retrieval {
+    /// Queries with at least one other observation of the same person.
+    pub queries: usize,
+    /// Share of queries whose nearest other observation is the same person.
+    pub rank1: f64,
+    /// Mean over queries of the average precision of the ranking.
+    pub map: f64,
+}
+
+/// Rank-1 and mAP of `features` (one per observation) against `truth`.
+pub fn retrieval<T: PartialEq>(features: &[Vec<f64>], truth: &[T]) -> Retrieval {
+    let n = features.len().min(truth.len());
+    let (mut queries, mut hits, mut ap_sum) = (0usize, 0usize, 0.0);
+    for q in 0..n {
+        let positives = (0..n).filter(|&g| g != q && truth[g] == truth[q]).count();
+        if positives == 0 {
+            continue;
+        }
+        let mut ranked: Vec<(f64, usize)> = (0..n)
+            .filter(|&g| g != q)
+            .map(|g| {
+                let d: f64 = features[q]
+                    .iter()
+                    .zip(&features[g])
+                    .map(|(a, b)| (a - b).powi(2))
+                    .sum();
+                (d, g)
+            })
+            .collect();
+        ranked.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        queries += 1;
+        hits += usize::from(truth[ranked[0].1] == truth[q]);
+        let (mut found, mut ap) = (0usize, 0.0);
+        for (rank, (_, g)) in ranked.iter().enumerate() {
+            if truth[*g] == truth[q] {
+                found += 1;
+                ap += found as f64 / (rank + 1) as f64;
+            }
+        }
+        ap_sum += ap / positives as f64;
+    }
+    let q = queries.max(1) as f64;
+    Retrieval {
+        queries,
+        rank1: hits as f64 / q,
+        map: ap_sum / q,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn retrieval_by_hand() {
+        // 1-D features: a a' b b' c, where b' sits nearer to a than to b
+        let f: Vec<Vec<f64>> = [0.0, 0.1, 5.0, 0.3, 9.0].iter().map(|v| vec![*v]).collect();
+        let truth = ["a", "a", "b", "b", "c"];
+        let r = retrieval(&f, &truth);
+        // c has no partner: 4 queries. a → a' (hit, AP 1); a' → a (hit, AP 1);
+        // b (5) → c 4.0, b' 4.7, a' 4.9, a 5.0: miss, b' at rank 2, AP 1/2;
+        // b' (0.3) → a' 0.2, a 0.3, b 4.7: miss, AP 1/3
+        assert_eq!(r.queries, 4);
+        assert_eq!(r.rank1, 0.5);
+        assert!((r.map - (2.0 + 0.5 + 1.0 / 3.0) / 4.0).abs() < 1e-15);
+    }
 
     #[test]
     fn a_perfect_labelling_up_to_renaming() {
