@@ -41,6 +41,7 @@ mod components;
 mod local_tracks;
 mod params;
 mod reid;
+mod reid_figures;
 mod reid_report;
 mod roc;
 mod session;
@@ -121,6 +122,7 @@ impl Experiment for BackgroundTracking {
         colour_report::products(ctx, p, &mut products)?;
         local_tracks::products(ctx, p, &mut products)?;
         reid_report::products(ctx, p, &mut products)?;
+        reid_figures::products(ctx, &p.reid, &mut products)?;
         wallflower::products(p, &mut products)?;
         Ok(products)
     }
