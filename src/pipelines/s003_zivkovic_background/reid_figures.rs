@@ -54,9 +54,7 @@ fn timeline(obs: &[&Observation], est: &[usize], session: &str) -> Figure {
     let by_label = segments(obs, |i| est[i], truth, "label");
     Figure::new(
         "reid_timeline",
-        format!(
-            "Identity timeline, {session}: local tracks by true person, coloured by truth (top) and by the paper's model (bottom)"
-        ),
+        format!("Identity timeline ({session}): truth vs the paper's model"),
         FigureKind::Panels(Panels {
             columns: 1,
             panels: vec![
@@ -92,7 +90,7 @@ fn features_over_time(rows: &[ReidFrameRow], obs: &Observation, session: &str) -
     Figure::new(
         "reid_features_fig4b",
         format!(
-            "Fig. 4b: the first three feature components (top region, ln grey-world r, g, b) over one local track ({session}, person {})",
+            "Fig. 4b: top-region r, g, b over one track ({session}, person {})",
             obs.id
         ),
         FigureKind::Lines(LinePlot {
