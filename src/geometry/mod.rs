@@ -3,6 +3,7 @@
 //! cameras use the optical frame (x right, y down, z forward).
 
 pub mod camera;
+pub mod fundamental;
 pub mod rect;
 pub mod triangulate;
 

@@ -21,6 +21,7 @@ use image::RgbImage;
 use super::local_tracks::TrackRow;
 use super::params::Params;
 use super::shared::Frame;
+use crate::geometry::rect;
 use crate::report::rows::Rows;
 use crate::run::SessionTables;
 use crate::table_row;
@@ -142,14 +143,6 @@ pub(super) fn region_means(rgb: &RgbImage, b: [f64; 4]) -> Option<[f64; 9]> {
     Some(out)
 }
 
-fn iou(a: [f64; 4], b: [f64; 4]) -> f64 {
-    let iw = (a[2].min(b[2]) - a[0].max(b[0])).max(0.0);
-    let ih = (a[3].min(b[3]) - a[1].max(b[1])).max(0.0);
-    let inter = iw * ih;
-    let union = (a[2] - a[0]) * (a[3] - a[1]) + (b[2] - b[0]) * (b[3] - b[1]) - inter;
-    if union > 0.0 { inter / union } else { 0.0 }
-}
-
 /// The re-identification features of one session.
 pub(super) struct ReidRun {
     wanted: bool,
@@ -195,7 +188,7 @@ impl ReidRun {
             let b = [t.x0, t.y0, t.x1, t.y1];
             let truth_id = truth_boxes
                 .iter()
-                .map(|(id, g)| (*id, iou(b, *g)))
+                .map(|(id, g)| (*id, rect::iou(&b, g)))
                 .filter(|(_, o)| *o >= self.min_iou)
                 .max_by(|a, b| a.1.total_cmp(&b.1))
                 .map(|(id, _)| id);
@@ -252,11 +245,5 @@ mod tests {
         assert_eq!(channel_means(&img), [100.0, 1.0, 50.0]);
         assert_eq!(region_means(&img, [4.0, 4.0, 4.0, 10.0]), None, "empty box");
         assert_eq!(region_means(&img, [0.0, f64::NAN, 8.0, 16.0]), None);
-    }
-
-    #[test]
-    fn box_overlap() {
-        assert_eq!(iou([0.0, 0.0, 2.0, 2.0], [1.0, 0.0, 3.0, 2.0]), 1.0 / 3.0);
-        assert_eq!(iou([0.0, 0.0, 1.0, 1.0], [2.0, 2.0, 3.0, 3.0]), 0.0);
     }
 }
