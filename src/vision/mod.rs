@@ -21,6 +21,8 @@
 //! - [`gabor`]: the Gabor-feature background model and MAD threshold of seed 004 §2.
 //! - [`jabri`]: seed 002 §4's background subtraction after Jabri et al. (colour × edge planes,
 //!   recursive mean and σ with forgetting, moving-blob rectangles).
+//! - [`klt`]: Shi–Tomasi corners and pyramidal Lucas–Kanade tracking (seed 003 §III's
+//!   moving-camera features, seed 001's Method 1).
 //! - [`skin`]: seed 002 §4's skin segmentation (normalised-rgb histogram back-projection,
 //!   smoothing, hysteresis bounded by Canny edges) and the top-fifth person test.
 //! - [`template`]: human-silhouette template detection of seed 004 §3.
@@ -34,6 +36,7 @@ pub mod ellipse;
 pub mod gabor;
 pub mod gmm;
 pub mod jabri;
+pub mod klt;
 pub mod local;
 pub mod omni;
 pub mod score;
