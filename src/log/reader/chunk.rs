@@ -143,6 +143,39 @@ thread_local! {
     static ZSTD: RefCell<Option<zstd::bulk::Decompressor<'static>>> = const { RefCell::new(None) };
 }
 
+/// Whether [`walk`] would keep every record of `all` as it is, without an error: only
+/// definitions within their size limit and messages kept whole, each record within the data.
+fn all_kept_whole(all: &[u8], keep: &mut dyn FnMut(u16) -> Keep) -> bool {
+    let mut at = 0;
+    while at < all.len() {
+        let Some(head) = all[at..].first_chunk::<RECORD_HEAD_LEN>() else {
+            return false;
+        };
+        let (opcode, len) = record_head(head);
+        let body = at + RECORD_HEAD_LEN;
+        let Some(end) = usize::try_from(len)
+            .ok()
+            .and_then(|len| body.checked_add(len))
+            .filter(|&end| end <= all.len())
+        else {
+            return false;
+        };
+        let kept = match opcode {
+            op::SCHEMA | op::CHANNEL => len <= MAX_DEFINITION_BYTES,
+            op::MESSAGE if len >= MESSAGE_HEADER_LEN as u64 => {
+                parse_message_header(&all[body..end])
+                    .is_ok_and(|h| keep(h.channel) == Keep::Whole)
+            }
+            _ => false,
+        };
+        if !kept {
+            return false;
+        }
+        at = end;
+    }
+    true
+}
+
 /// [`open_chunk`], keeping of each message what `keep(channel id)` says.
 pub(super) fn open_chunk_keeping(
     body: &[u8],
@@ -181,8 +214,15 @@ pub(super) fn open_chunk_keeping(
         && let Some(all) = zstd_whole(h.records, want)
     {
         // the same walk, then the same CRC check, as the stream below; a record cut short
-        // by the end of the data is left to the stream, which names it
-        match walk(&mut Bytes { buf: &all, at: 0 }, want, keep) {
+        // by the end of the data is left to the stream, which names it. When every record is
+        // kept as it is, the walk's output would be the data itself: no copy is made.
+        let whole = all_kept_whole(&all, keep);
+        let walked = if whole {
+            Ok(Vec::new())
+        } else {
+            walk(&mut Bytes { buf: &all, at: 0 }, want, keep)
+        };
+        match walked {
             Ok(data) => {
                 if h.crc != 0 {
                     let computed = crc32fast::hash(&all);
@@ -201,7 +241,7 @@ pub(super) fn open_chunk_keeping(
                     start: Nanos(h.start),
                     end: Nanos(h.end),
                     compression: h.compression,
-                    data,
+                    data: if whole { all } else { data },
                 });
             }
             Err(Walk::Bad(reason)) => return Err(bad("chunk", offset)(reason)),
