@@ -6,7 +6,10 @@ Rows:
 - read + decode every message (`read_decode/NAME`: typed fast paths where a channel has one,
   the value tree elsewhere) beside Python mcap-ros2-support, with `NAME_dynamic` (value tree
   only) and the physical limit `NAME_limit` (file read + zstd/lz4 decompression + one copy of
-  each payload): "limit %" is limit time / decode time (100 % = decoding is free);
+  each payload): "limit %" is limit time / decode time (100 % = decoding is free); "py limit
+  s" is the same limit measured in Python (its zstandard/lz4 modules, one copy per payload) and
+  "ceiling" is Python's time over our limit: the largest ratio any reader of ours could show
+  on that file (where Python's time is itself mostly decompression, the ceiling is low);
 - with a binary: `peopletrack cat LOG --topic T` as a whole process, JSON to /dev/null (best of
   5), beside Python decoding that topic alone with no output.
 """
@@ -38,7 +41,7 @@ def main(criterion_dir, python_json, binary=None):
     print("read + decode every message (ours: typed fast paths + value tree; peer: mcap-ros2-support)")
     print(
         f"{'log':36} {'messages':>9} {'MB':>7} {'ours s':>9} {'python s':>9} {'ratio':>8} "
-        f"{'dynamic s':>10} {'limit s':>9} {'limit %':>8} {'ours MB/s':>10}"
+        f"{'dynamic s':>10} {'limit s':>9} {'limit %':>8} {'ours MB/s':>10} {'py limit s':>11} {'ceiling':>8}"
     )
     for name, p in py.items():
         if name.startswith("cat:"):
@@ -51,10 +54,13 @@ def main(criterion_dir, python_json, binary=None):
         mb = p["payload_bytes"] / 1e6
         fmt = lambda x, w, d: f"{x:>{w}.{d}f}" if x is not None else f"{'-':>{w}}"
         pct = 100.0 * lim_s / rust_s if lim_s is not None else None
+        py_lim = p.get("limit_seconds")
+        ceiling = p["seconds"] / lim_s if lim_s else None
         print(
             f"{name:36} {p['messages']:>9} {mb:>7.1f} {rust_s:>9.4f} {p['seconds']:>9.3f} "
             f"{p['seconds'] / rust_s:>7.1f}x {fmt(dyn_s, 10, 4)} {fmt(lim_s, 9, 4)} "
-            f"{fmt(pct, 7, 0)}% {mb / rust_s:>10.1f}"
+            f"{fmt(pct, 7, 0)}% {mb / rust_s:>10.1f} {fmt(py_lim, 11, 3)} "
+            + (f"{ceiling:>7.1f}x" if ceiling is not None else f"{'-':>8}")
         )
     cats = {k: v for k, v in py.items() if k.startswith("cat:")}
     if binary and cats:

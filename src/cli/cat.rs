@@ -1,14 +1,22 @@
 //! `peopletrack cat LOG --topic T`: decoded messages of one topic as JSON lines, any type
-//! (ROS 2 CDR through the dynamic decoder, Foxglove protobuf, JSON).
+//! (ROS 2 CDR straight from the wire bytes, Foxglove protobuf and JSON through the value tree).
 //!
 //! Each line: `{"topic", "log_time_ns", "publish_time_ns", "sequence", "message"}`. Non-finite
 //! floats are written `"NaN"`, `"Infinity"`, `"-Infinity"` (the protobuf JSON convention), so
 //! lines stay valid JSON and no-returns stay visible.
+//!
+//! Lines are built in one reused buffer (no per-message allocation for CDR channels, whose
+//! messages are written by [`peopletrack::log::cdr::write_json`] without a value tree) and
+//! handed to the output some 64 KiB at a time.
 
 use std::path::PathBuf;
 
-use peopletrack::log::value::Json;
+use serde_json::ser::{CompactFormatter, Formatter};
+
 use peopletrack::log::{Decoders, SessionLog};
+
+/// Bytes of lines gathered before they are written out.
+const WRITE_BATCH: usize = 1 << 16;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -41,28 +49,39 @@ pub fn run(args: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     }
     let mut decoders = Decoders::new();
     let limit = args.limit.unwrap_or(usize::MAX);
+    let mut buf = Vec::with_capacity(2 * WRITE_BATCH);
+    let mut topic = Vec::new();
+    serde_json::to_writer(&mut topic, &args.topic)?;
     for m in log.messages_on(&[args.topic.as_str()])?.take(limit) {
-        let m = m?;
-        let v = decoders.value(&log, &m)?;
-        let line = Line {
-            topic: m.topic(),
-            log_time_ns: m.log_time.0,
-            publish_time_ns: m.publish_time.0,
-            sequence: m.sequence,
-            message: v.json(args.max_array),
+        let m = match m {
+            Ok(m) => m,
+            Err(e) => {
+                // the complete lines before the damage are printed, as they always were
+                out.write_all(&buf)?;
+                return Err(e.into());
+            }
         };
-        serde_json::to_writer(&mut *out, &line)?;
-        out.write_all(b"\n")?;
+        let line_start = buf.len();
+        // keys in this order: topic, log_time_ns, publish_time_ns, sequence, message
+        buf.extend_from_slice(b"{\"topic\":");
+        buf.extend_from_slice(&topic);
+        buf.extend_from_slice(b",\"log_time_ns\":");
+        CompactFormatter.write_u64(&mut buf, m.log_time.0)?;
+        buf.extend_from_slice(b",\"publish_time_ns\":");
+        CompactFormatter.write_u64(&mut buf, m.publish_time.0)?;
+        buf.extend_from_slice(b",\"sequence\":");
+        CompactFormatter.write_u32(&mut buf, m.sequence)?;
+        buf.extend_from_slice(b",\"message\":");
+        if let Err(e) = decoders.write_json(&log, &m, args.max_array, &mut buf) {
+            out.write_all(&buf[..line_start])?;
+            return Err(e.into());
+        }
+        buf.extend_from_slice(b"}\n");
+        if buf.len() >= WRITE_BATCH {
+            out.write_all(&buf)?;
+            buf.clear();
+        }
     }
+    out.write_all(&buf)?;
     Ok(())
-}
-
-/// One output line, streamed by `serde_json` (no JSON tree is built; keys in this order).
-#[derive(serde::Serialize)]
-struct Line<'a> {
-    topic: &'a str,
-    log_time_ns: u64,
-    publish_time_ns: u64,
-    sequence: u32,
-    message: Json<'a>,
 }

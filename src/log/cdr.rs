@@ -124,9 +124,11 @@ type Result<T> = std::result::Result<T, CdrError>;
 
 mod cursor;
 mod encode;
+mod json;
 
 pub use cursor::Cursor;
 pub use encode::{default_value, encode, literal_value};
+pub use json::{FloatText, write_json};
 
 /// Parse the encapsulation header: byte order and maximum alignment.
 fn encapsulation(data: &[u8]) -> Result<(Endian, usize)> {

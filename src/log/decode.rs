@@ -116,6 +116,8 @@ pub struct Decoders {
     by_channel: HashMap<u16, Entry>,
     /// Reused buffers of [`Decoders::decode`].
     scratch: Scratch,
+    /// Float texts reused by [`Decoders::write_json`].
+    floats: cdr::FloatText,
 }
 
 impl Decoders {
@@ -149,6 +151,37 @@ impl Decoders {
         let dec = self.decoder(log, msg)?;
         dec.decode(&msg.data).map_err(|k| {
             LogError::new(log.path(), k)
+                .on_topic(msg.topic())
+                .at(msg.log_time)
+        })
+    }
+
+    /// Append a message's JSON rendering (the text of [`Value::json`]) to `out`: CDR channels
+    /// straight from the wire bytes ([`cdr::write_json`], no value tree), the others through
+    /// the value tree. Errors are the dynamic decoder's, naming file, topic and log time.
+    pub fn write_json(
+        &mut self,
+        log: &SessionLog,
+        msg: &Message,
+        max_array: Option<usize>,
+        out: &mut Vec<u8>,
+    ) -> Result<(), LogError> {
+        let mark = out.len();
+        self.entry(msg);
+        if let Some(Entry {
+            decoder: Ok(Decoder::Cdr(reg)),
+            ..
+        }) = self.by_channel.get(&msg.channel.id)
+        {
+            if cdr::write_json(reg, &msg.data, max_array, &mut self.floats, out).is_ok() {
+                return Ok(());
+            }
+            // the same walk as the dynamic decoder: let it report the error
+            out.truncate(mark);
+        }
+        let v = self.value(log, msg)?;
+        serde_json::to_writer(&mut *out, &v.json(max_array)).map_err(|e| {
+            LogError::new(log.path(), LogErrorKind::Json(e.to_string()))
                 .on_topic(msg.topic())
                 .at(msg.log_time)
         })

@@ -142,3 +142,142 @@ fn encoder_checks_ranges_bounds_and_unknown_fields() {
         Err(CdrErrorKind::UnknownField(_))
     ));
 }
+
+/// `write_json` text of a payload (a fresh float cache, or the one given).
+fn json_text(r: &Registry, data: &[u8], max: Option<usize>, floats: &mut FloatText) -> String {
+    let mut out = Vec::new();
+    write_json(r, data, max, floats, &mut out).expect("writes");
+    String::from_utf8(out).expect("utf-8")
+}
+
+#[test]
+fn json_of_known_bytes() {
+    let r = reg(HEADER_SCHEMA);
+    assert_eq!(
+        json_text(&r, HEADER_THEN_F64, None, &mut FloatText::default()),
+        r#"{"header":{"stamp":{"sec":1,"nanosec":2},"frame_id":"ab"},"x":1.0}"#
+    );
+    assert_eq!(
+        json_text(&reg(""), &[0, 1, 0, 0, 0], None, &mut FloatText::default()),
+        "{}"
+    );
+}
+
+const EVERY_TYPE: &str = "bool b\nbyte y\nchar ch\nint8 i8v\nuint8 u8v\nint16 a\nuint16 u16v\n\
+    int32 i32v\nuint32 u32v\nint64 i64v\nuint64 u64v\nfloat32 f\nfloat64 d\nstring s\nwstring w\n\
+    bool[] bs\nuint8[] by\nint8[3] i8s\nint16[] i16s\nuint16[] u16s\nint32[] i32s\nuint32[] u32s\n\
+    int64[] i64s\nuint64[2] u64s\nfloat32[] fs\nfloat64[<=4] ds\nstring[] ss\nt/Inner[] inner\n\
+    ===\nMSG: t/Inner\nfloat64 x\nstring[] names";
+
+fn every_type() -> Value {
+    let inner = |x: f64, names: &[&str]| {
+        Value::Struct(vec![
+            ("x".into(), Value::F64(x)),
+            (
+                "names".into(),
+                Value::Array(names.iter().map(|n| Value::String((*n).into())).collect()),
+            ),
+        ])
+    };
+    Value::Struct(vec![
+        ("b".into(), Value::Bool(true)),
+        ("y".into(), Value::U8(255)),
+        ("ch".into(), Value::U8(65)),
+        ("i8v".into(), Value::I8(-128)),
+        ("u8v".into(), Value::U8(7)),
+        ("a".into(), Value::I16(-2)),
+        ("u16v".into(), Value::U16(65535)),
+        ("i32v".into(), Value::I32(i32::MIN)),
+        ("u32v".into(), Value::U32(u32::MAX)),
+        ("i64v".into(), Value::I64(i64::MIN)),
+        ("u64v".into(), Value::U64(u64::MAX)),
+        ("f".into(), Value::F32(0.1)),
+        ("d".into(), Value::F64(-1e-300)),
+        ("s".into(), Value::String("q\"\\\n\u{1}é".into())),
+        ("w".into(), Value::String("ü€".into())),
+        ("bs".into(), Value::Bools(vec![true, false, true])),
+        ("by".into(), Value::Bytes(vec![0, 1, 255])),
+        ("i8s".into(), Value::I8s(vec![-1, 0, 1])),
+        ("i16s".into(), Value::I16s(vec![-300, 300])),
+        ("u16s".into(), Value::U16s(vec![1, 2, 3])),
+        ("i32s".into(), Value::I32s(vec![-5])),
+        ("u32s".into(), Value::U32s(vec![])),
+        ("i64s".into(), Value::I64s(vec![1 << 40, -(1 << 40)])),
+        ("u64s".into(), Value::U64s(vec![0, u64::MAX])),
+        (
+            "fs".into(),
+            Value::F32s(vec![
+                0.1,
+                f32::NAN,
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+                0.1,
+                3.0,
+            ]),
+        ),
+        ("ds".into(), Value::F64s(vec![1.5, 1e21, -0.0])),
+        (
+            "ss".into(),
+            Value::Array(vec![Value::String("a".into()), Value::String("".into())]),
+        ),
+        (
+            "inner".into(),
+            Value::Array(vec![
+                inner(1.0, &["x", "y"]),
+                inner(f64::NAN, &[]),
+                inner(2.5, &["z"]),
+            ]),
+        ),
+    ])
+}
+
+#[test]
+fn json_is_the_value_tree_text_for_every_type_both_byte_orders_and_cuts() {
+    let r = reg(EVERY_TYPE);
+    let v = every_type();
+    let mut floats = FloatText::default();
+    for endian in [Endian::Little, Endian::Big] {
+        let bytes = encode(&r, &v, endian).expect("encodes");
+        let tree = decode(&r, &bytes).expect("decodes");
+        for max in [None, Some(0), Some(1), Some(2), Some(100)] {
+            let want = serde_json::to_string(&tree.json(max)).expect("json");
+            // twice with one cache: the second pass reads every float text from it
+            for _ in 0..2 {
+                assert_eq!(json_text(&r, &bytes, max, &mut floats), want, "{max:?}");
+            }
+        }
+    }
+    // a hand-checked piece: cut arrays say how many elements were left out
+    let bytes = encode(&r, &v, Endian::Little).expect("encodes");
+    let text = json_text(&r, &bytes, Some(1), &mut FloatText::default());
+    assert!(
+        text.contains(r#""fs":[0.10000000149011612,"... 5 more"]"#),
+        "{text}"
+    );
+    assert!(text.contains(r#""u32s":[]"#), "{text}");
+    assert!(
+        text.contains(r#""inner":[{"x":1.0,"names":["x","... 1 more"]},"... 2 more"]"#),
+        "{text}"
+    );
+    let full = json_text(&r, &bytes, None, &mut FloatText::default());
+    assert!(
+        full.contains(r#""fs":[0.10000000149011612,"NaN","Infinity","-Infinity","#),
+        "{full}"
+    );
+}
+
+#[test]
+fn json_refuses_what_the_decoder_refuses() {
+    let r = reg(HEADER_SCHEMA);
+    let mut out = Vec::new();
+    let short = &HEADER_THEN_F64[..HEADER_THEN_F64.len() - 3];
+    let err = write_json(&r, short, None, &mut FloatText::default(), &mut out)
+        .expect_err("cut payload");
+    assert_eq!(Err(err), decode(&r, short));
+    // a huge count of elements that take no bytes on the wire
+    let r = reg("t/E[] many\n===\nMSG: t/E\n");
+    let bomb = [0, 1, 0, 0, 0xff, 0xff, 0xff, 0x0f];
+    let err = write_json(&r, &bomb, None, &mut FloatText::default(), &mut out)
+        .expect_err("too many empty elements");
+    assert_eq!(Err(err), decode(&r, &bomb));
+}

@@ -5,6 +5,7 @@
 //! takes 2 GiB: memory is what is kept, not what the chunk holds. The CRC is computed over
 //! every byte as it streams past, so nothing kept is handed out before it is verified.
 
+use std::cell::RefCell;
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::{self, BufReader, Read};
 use std::sync::Arc;
@@ -70,6 +71,111 @@ impl<R: Read> Read for Tally<R> {
     }
 }
 
+/// Records read by [`walk`]: how many bytes have passed, and skipping without copying where
+/// the bytes are already in memory.
+trait Records: Read {
+    fn count(&self) -> u64;
+    fn skip(&mut self, len: u64) -> io::Result<()>;
+}
+
+impl<R: Read> Records for Tally<R> {
+    fn count(&self) -> u64 {
+        self.count
+    }
+    fn skip(&mut self, len: u64) -> io::Result<()> {
+        skip(self, len)
+    }
+}
+
+/// A whole decompressed chunk in memory.
+struct Bytes<'a> {
+    buf: &'a [u8],
+    at: usize,
+}
+
+impl Read for Bytes<'_> {
+    fn read(&mut self, out: &mut [u8]) -> io::Result<usize> {
+        let n = (&self.buf[self.at..]).read(out)?;
+        self.at += n;
+        Ok(n)
+    }
+}
+
+impl Records for Bytes<'_> {
+    fn count(&self) -> u64 {
+        self.at as u64
+    }
+    fn skip(&mut self, len: u64) -> io::Result<()> {
+        let left = self.buf.len() - self.at;
+        match usize::try_from(len) {
+            Ok(n) if n <= left => {
+                self.at += n;
+                Ok(())
+            }
+            _ => Err(io::ErrorKind::UnexpectedEof.into()),
+        }
+    }
+}
+
+/// zstd chunks of at most this many uncompressed bytes (real ones are a few MiB) are
+/// decompressed in one call, which is faster than the stream and skips unwanted records
+/// without copying them; a larger declared size takes the streaming path, so a corrupt size
+/// field never allocates more than this.
+const BULK_MAX_BYTES: u64 = 64 << 20;
+
+/// The whole zstd frame `src`, if it decompresses to exactly `want` bytes (else `None`: the
+/// streaming path then reads it and says what is wrong).
+fn zstd_whole(src: &[u8], want: u64) -> Option<Vec<u8>> {
+    let want = usize::try_from(want).ok()?;
+    let mut out = Vec::with_capacity(want);
+    let n = ZSTD.with(|d| {
+        let mut d = d.try_borrow_mut().ok()?;
+        if d.is_none() {
+            *d = zstd::bulk::Decompressor::new().ok();
+        }
+        d.as_mut()?.decompress_to_buffer(src, &mut out).ok()
+    })?;
+    (n == want).then_some(out)
+}
+
+thread_local! {
+    /// One zstd decompression context per thread, reused from chunk to chunk.
+    static ZSTD: RefCell<Option<zstd::bulk::Decompressor<'static>>> = const { RefCell::new(None) };
+}
+
+/// Whether [`walk`] would keep every record of `all` as it is, without an error: only
+/// definitions within their size limit and messages kept whole, each record within the data.
+fn all_kept_whole(all: &[u8], keep: &mut dyn FnMut(u16) -> Keep) -> bool {
+    let mut at = 0;
+    while at < all.len() {
+        let Some(head) = all[at..].first_chunk::<RECORD_HEAD_LEN>() else {
+            return false;
+        };
+        let (opcode, len) = record_head(head);
+        let body = at + RECORD_HEAD_LEN;
+        let Some(end) = usize::try_from(len)
+            .ok()
+            .and_then(|len| body.checked_add(len))
+            .filter(|&end| end <= all.len())
+        else {
+            return false;
+        };
+        let kept = match opcode {
+            op::SCHEMA | op::CHANNEL => len <= MAX_DEFINITION_BYTES,
+            op::MESSAGE if len >= MESSAGE_HEADER_LEN as u64 => {
+                parse_message_header(&all[body..end])
+                    .is_ok_and(|h| keep(h.channel) == Keep::Whole)
+            }
+            _ => false,
+        };
+        if !kept {
+            return false;
+        }
+        at = end;
+    }
+    true
+}
+
 /// [`open_chunk`], keeping of each message what `keep(channel id)` says.
 pub(super) fn open_chunk_keeping(
     body: &[u8],
@@ -103,6 +209,45 @@ pub(super) fn open_chunk_keeping(
         compression: h.compression.clone(),
         reason,
     };
+    if h.compression == "zstd"
+        && want <= BULK_MAX_BYTES
+        && let Some(all) = zstd_whole(h.records, want)
+    {
+        // the same walk, then the same CRC check, as the stream below; a record cut short
+        // by the end of the data is left to the stream, which names it. When every record is
+        // kept as it is, the walk's output would be the data itself: no copy is made.
+        let whole = all_kept_whole(&all, keep);
+        let walked = if whole {
+            Ok(Vec::new())
+        } else {
+            walk(&mut Bytes { buf: &all, at: 0 }, want, keep)
+        };
+        match walked {
+            Ok(data) => {
+                if h.crc != 0 {
+                    let computed = crc32fast::hash(&all);
+                    if computed != h.crc {
+                        return Err(LogErrorKind::ChunkCrc {
+                            offset,
+                            start: Nanos(h.start),
+                            end: Nanos(h.end),
+                            topics: topics(),
+                            stored: h.crc,
+                            computed,
+                        });
+                    }
+                }
+                return Ok(OpenChunk {
+                    start: Nanos(h.start),
+                    end: Nanos(h.end),
+                    compression: h.compression,
+                    data: if whole { all } else { data },
+                });
+            }
+            Err(Walk::Bad(reason)) => return Err(bad("chunk", offset)(reason)),
+            Err(Walk::Io(_)) => {}
+        }
+    }
     let inner: Box<dyn Read + '_> = match h.compression.as_str() {
         "" => Box::new(h.records),
         "zstd" => Box::new(BufReader::with_capacity(
@@ -172,19 +317,19 @@ impl From<io::Error> for Walk {
 }
 
 /// Read `want` bytes of records from `r`, keeping definitions and the messages `keep` wants.
-fn walk<R: Read>(
-    r: &mut Tally<R>,
+fn walk<R: Records>(
+    r: &mut R,
     want: u64,
     keep: &mut dyn FnMut(u16) -> Keep,
 ) -> Result<Vec<u8>, Walk> {
     let mut out = Vec::new();
-    while r.count < want {
-        let at = r.count;
+    while r.count() < want {
+        let at = r.count();
         let mut head = [0u8; RECORD_HEAD_LEN];
         r.read_exact(&mut head)?;
         let (opcode, len) = record_head(&head);
         // the record head itself may run past the chunk's declared size (found by fuzzing)
-        let Some(left) = want.checked_sub(r.count) else {
+        let Some(left) = want.checked_sub(r.count()) else {
             return Err(Walk::Bad(format!(
                 "record head at chunk byte {at} runs past the chunk's {want} uncompressed bytes"
             )));
@@ -220,9 +365,9 @@ fn walk<R: Read>(
                         out.push(op::MESSAGE);
                         out.extend_from_slice(&(MESSAGE_HEADER_LEN as u64).to_le_bytes());
                         out.extend_from_slice(&fixed);
-                        skip(r, rest)?;
+                        r.skip(rest)?;
                     }
-                    Keep::Skip => skip(r, rest)?,
+                    Keep::Skip => r.skip(rest)?,
                 }
             }
             op::MESSAGE => {
@@ -231,7 +376,7 @@ fn walk<R: Read>(
                      {MESSAGE_HEADER_LEN}-byte header"
                 )));
             }
-            _ => skip(r, len)?,
+            _ => r.skip(len)?,
         }
     }
     Ok(out)
@@ -253,3 +398,6 @@ fn skip<R: Read>(r: &mut R, len: u64) -> io::Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests;
