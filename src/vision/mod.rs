@@ -26,12 +26,16 @@
 //! - [`skin`]: seed 002 §4's skin segmentation (normalised-rgb histogram back-projection,
 //!   smoothing, hysteresis bounded by Canny edges) and the top-fifth person test.
 //! - [`template`]: human-silhouette template detection of seed 004 §3.
+//! - [`cylinder`]: seed 001 §V's colour feature of a laser blob: the paracatadioptric image on a
+//!   cylinder, the blob's spherical ROI at chest height, hue–saturation histograms, the
+//!   printed correlation and the likelihood ratio.
 //!
 //! Kernels read frames and write into buffers the caller owns; nothing here reads logs or
 //! writes files.
 
 pub mod blobs;
 pub mod colortrack;
+pub mod cylinder;
 pub mod ellipse;
 pub mod gabor;
 pub mod gmm;
