@@ -4,6 +4,9 @@
 //! - [`kalman`]: linear Kalman filter, constant-velocity and random-walk models.
 //! - [`jpda`]: joint probabilistic data association (gated clusters, exact joint events, the
 //!   PDAF combined-innovation update).
+//! - [`pdaf`]: the single-target filter of seed 001 §V — PDAF with feature likelihood ratios,
+//!   CV / coordinated-turn / IMM models, elliptical and maneuver gates, the covariance reset
+//!   test; nearest-neighbour variant.
 //! - [`graph_match`]: 2-D tracking by graph matching of rectangles (seed 004 §4).
 //! - [`height_ekf`]: the (x, y, height) EKF of seed 002 §5 — laser range–bearing and camera
 //!   bearing + elevation updates, 3σ gate; a constant-velocity variant.
@@ -16,5 +19,6 @@ pub mod graph_match;
 pub mod height_ekf;
 pub mod jpda;
 pub mod kalman;
+pub mod pdaf;
 pub mod position;
 pub mod reid;
