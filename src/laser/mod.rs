@@ -15,6 +15,9 @@
 //!    person from [`crate::track::kalman`], global nearest neighbour with a Mahalanobis gate
 //!    through [`crate::assign`], M-of-N initiation and deletion, single-leg updates).
 //!
+//! [`follow`] is seed 001's single-target follower: blobs, their colour likelihood in the omni
+//! image ([`crate::vision::cylinder`]) and a PDAF ([`crate::track::pdaf`]) with the `rst` rule.
+//!
 //! [`training`] builds labelled segment samples for a learned leg detector (leg_tracker's
 //! training CSVs, parsed from text; synthetic ground-truth legs).
 //!
@@ -25,6 +28,7 @@
 
 pub mod circle;
 pub mod features;
+pub mod follow;
 pub mod legs;
 pub mod points;
 pub mod segment;

@@ -1,0 +1,504 @@
+//! Seed 001 §V (Kobilarov et al.): the single-target tracker of a person-following robot.
+//! Each scan is cut into blobs that might be people (the kinematic measurements); each blob's
+//! region in the omni image, lifted to chest height, gives a hue–saturation histogram whose
+//! correlation with the target's template is the feature likelihood ratio
+//! ([`crate::vision::cylinder`]); a PDAF with a constant-velocity, coordinated-turn or IMM
+//! model, or a nearest-neighbour filter ([`crate::track::pdaf`]), follows the target; when
+//! the position covariance passes the `rst` limit the track is dropped (the robot stops) and
+//! re-initialised on the nearest plausible blob.
+//!
+//! **Blobs** (our reading of "connected components that might have originated from people"):
+//! jump-distance segments ([`crate::laser::segment`]) merged while the gap between the end of
+//! one and the start of the next is under `merge_gap_m` (a person's two legs), kept when at
+//! most `max_width_m` wide (a ground hit of a pitching robot is a long arc and is not a
+//! blob) and within `max_range_m`. The measurement is the mean of the blob's points; its
+//! edges are its first and last points.
+//!
+//! Everything happens in one fixed frame (`odom` on the robot); the caller gives the points
+//! there, and the camera pose that maps fixed-frame points into the omni camera frame.
+
+use image::RgbImage;
+use nalgebra::Isometry3;
+
+use crate::geometry::camera::Paracatadioptric;
+use crate::laser::points::ScanPoint;
+use crate::laser::segment::{self, SegmentOptions, Threshold};
+use serde::{Deserialize, Serialize};
+
+use crate::track::pdaf::{AssociationKind, FilterError, FilterParams, ModelKind, TargetFilter};
+use crate::vision::cylinder::{self, CylinderMap};
+
+/// Parameters of the follower (the filter's inside).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FollowParams {
+    pub filter: FilterParams,
+    /// Jump distance that splits segments (m).
+    pub jump_m: f64,
+    /// Adjacent segments closer than this merge into one blob (m).
+    pub merge_gap_m: f64,
+    pub min_points: usize,
+    pub max_width_m: f64,
+    pub min_range_m: f64,
+    pub max_range_m: f64,
+    /// Use the colour likelihood ratio (false: lr = 1 for every blob).
+    pub colour: bool,
+    /// Height the blob is lifted to (chest) and half the ROI's vertical extent (m).
+    pub chest_height_m: f64,
+    pub roi_half_height_m: f64,
+    /// The paper's corr_min ("a small negative number").
+    pub corr_min: f64,
+    /// Template update weight per accepted scan (0: the template stays as initialised).
+    pub template_update: f64,
+    /// The first blob must lie this close to the initial point (m).
+    pub init_radius_m: f64,
+    /// Re-initialisation after `rst`: the nearest blob within this radius of the last
+    /// estimate (m), growing at `v_max` while the target is lost, up to `reinit_max_m`.
+    pub reinit_radius_m: f64,
+    pub reinit_max_m: f64,
+    /// Cylinder resolution (columns over 2π, rows over the mirror's elevations).
+    pub cylinder: [usize; 2],
+}
+
+impl Default for FollowParams {
+    /// Chosen a priori (not searched): blobs as wide as a person with both legs, the chest at
+    /// 1.3 m for a 1.8 m person, ±0.3 m of torso, corr_min −0.1.
+    fn default() -> Self {
+        FollowParams {
+            filter: FilterParams::default(),
+            jump_m: 0.1,
+            merge_gap_m: 0.5,
+            min_points: 2,
+            max_width_m: 1.0,
+            min_range_m: 0.3,
+            max_range_m: 10.0,
+            colour: true,
+            chest_height_m: 1.3,
+            roi_half_height_m: 0.3,
+            corr_min: -0.1,
+            template_update: 0.0,
+            init_radius_m: 1.0,
+            reinit_radius_m: 1.5,
+            reinit_max_m: 4.0,
+            cylinder: [720, 120],
+        }
+    }
+}
+
+/// The follower's settings as a pipeline or scenario file writes them (`[params.follower]`,
+/// `[robot.follow.pdaf]`); [`FollowSpec::params`] picks the motion model, the association and
+/// whether colour is used.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FollowSpec {
+    pub p_d: f64,
+    pub gate: f64,
+    pub clutter_density: f64,
+    pub sigma_r: f64,
+    pub accel_noise: f64,
+    pub turn_noise: f64,
+    pub imm_switch: f64,
+    pub v_max: f64,
+    pub a_max: f64,
+    pub reset_sigmas: f64,
+    pub init_speed_sigma: f64,
+    pub init_turn_sigma: f64,
+    pub jump_m: f64,
+    pub merge_gap_m: f64,
+    pub min_points: usize,
+    pub max_width_m: f64,
+    pub min_range_m: f64,
+    pub max_range_m: f64,
+    pub chest_height_m: f64,
+    pub roi_half_height_m: f64,
+    pub corr_min: f64,
+    pub template_update: f64,
+    pub init_radius_m: f64,
+    pub reinit_radius_m: f64,
+    pub reinit_max_m: f64,
+}
+
+impl Default for FollowSpec {
+    fn default() -> Self {
+        let p = FollowParams::default();
+        let f = &p.filter;
+        FollowSpec {
+            p_d: f.p_d,
+            gate: f.gate,
+            clutter_density: f.clutter_density,
+            sigma_r: f.sigma_r,
+            accel_noise: f.accel_noise,
+            turn_noise: f.turn_noise,
+            imm_switch: f.imm_switch,
+            v_max: f.v_max,
+            a_max: f.a_max,
+            reset_sigmas: f.reset_sigmas,
+            init_speed_sigma: f.init_speed_sigma,
+            init_turn_sigma: f.init_turn_sigma,
+            jump_m: p.jump_m,
+            merge_gap_m: p.merge_gap_m,
+            min_points: p.min_points,
+            max_width_m: p.max_width_m,
+            min_range_m: p.min_range_m,
+            max_range_m: p.max_range_m,
+            chest_height_m: p.chest_height_m,
+            roi_half_height_m: p.roi_half_height_m,
+            corr_min: p.corr_min,
+            template_update: p.template_update,
+            init_radius_m: p.init_radius_m,
+            reinit_radius_m: p.reinit_radius_m,
+            reinit_max_m: p.reinit_max_m,
+        }
+    }
+}
+
+impl FollowSpec {
+    /// The follower's parameters with this motion model, association and colour setting.
+    pub fn params(&self, model: ModelKind, association: AssociationKind, colour: bool) -> FollowParams {
+        FollowParams {
+            filter: FilterParams {
+                model,
+                association,
+                p_d: self.p_d,
+                gate: self.gate,
+                clutter_density: self.clutter_density,
+                sigma_r: self.sigma_r,
+                accel_noise: self.accel_noise,
+                turn_noise: self.turn_noise,
+                imm_switch: self.imm_switch,
+                v_max: self.v_max,
+                a_max: self.a_max,
+                reset_sigmas: self.reset_sigmas,
+                init_speed_sigma: self.init_speed_sigma,
+                init_turn_sigma: self.init_turn_sigma,
+            },
+            jump_m: self.jump_m,
+            merge_gap_m: self.merge_gap_m,
+            min_points: self.min_points,
+            max_width_m: self.max_width_m,
+            min_range_m: self.min_range_m,
+            max_range_m: self.max_range_m,
+            colour,
+            chest_height_m: self.chest_height_m,
+            roi_half_height_m: self.roi_half_height_m,
+            corr_min: self.corr_min,
+            template_update: self.template_update,
+            init_radius_m: self.init_radius_m,
+            reinit_radius_m: self.reinit_radius_m,
+            reinit_max_m: self.reinit_max_m,
+            cylinder: FollowParams::default().cylinder,
+        }
+    }
+
+    /// Values that would make the follower meaningless: `(key, reason)`.
+    pub fn problems(&self) -> Vec<(String, String)> {
+        let mut out = Vec::new();
+        for (k, v) in [
+            ("sigma_r", self.sigma_r),
+            ("gate", self.gate),
+            ("accel_noise", self.accel_noise),
+            ("turn_noise", self.turn_noise),
+            ("v_max", self.v_max),
+            ("a_max", self.a_max),
+            ("reset_sigmas", self.reset_sigmas),
+            ("init_speed_sigma", self.init_speed_sigma),
+            ("init_turn_sigma", self.init_turn_sigma),
+            ("jump_m", self.jump_m),
+            ("max_width_m", self.max_width_m),
+            ("max_range_m", self.max_range_m),
+            ("init_radius_m", self.init_radius_m),
+            ("reinit_radius_m", self.reinit_radius_m),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                out.push((k.to_string(), format!("{v} must be finite and > 0")));
+            }
+        }
+        for (k, v) in [("p_d", self.p_d), ("imm_switch", self.imm_switch), ("template_update", self.template_update)] {
+            if !(0.0..=1.0).contains(&v) {
+                out.push((k.to_string(), format!("{v} is not in [0, 1]")));
+            }
+        }
+        if !(self.clutter_density.is_finite() && self.clutter_density >= 0.0) {
+            out.push(("clutter_density".into(), format!("{} must be finite and >= 0", self.clutter_density)));
+        }
+        if !(self.corr_min.is_finite() && self.corr_min <= 0.0) {
+            out.push(("corr_min".into(), format!("{} must be finite and <= 0", self.corr_min)));
+        }
+        out
+    }
+}
+
+/// A blob of one scan (fixed frame).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Blob {
+    pub centre: [f64; 2],
+    pub left: [f64; 2],
+    pub right: [f64; 2],
+    pub width: f64,
+    pub points: usize,
+    pub range: f64,
+}
+
+/// The blobs of one scan's points (beam order; see the module doc).
+pub fn blobs(points: &[ScanPoint], p: &FollowParams) -> Vec<Blob> {
+    let segs = segment::segment(
+        points,
+        &SegmentOptions {
+            threshold: Threshold::Fixed(p.jump_m),
+            min_points: 1,
+        },
+    );
+    let mut groups: Vec<std::ops::Range<usize>> = Vec::new();
+    for s in segs {
+        if let Some(last) = groups.last_mut() {
+            let a = points[last.end - 1].fixed;
+            let b = points[s.points.start].fixed;
+            if (a - b).norm() < p.merge_gap_m {
+                last.end = s.points.end;
+                continue;
+            }
+        }
+        groups.push(s.points.clone());
+    }
+    groups
+        .into_iter()
+        .filter_map(|g| {
+            let pts = &points[g];
+            let (first, last) = (pts.first()?, pts.last()?);
+            let width = (first.fixed - last.fixed).norm();
+            let n = pts.len() as f64;
+            let cx = pts.iter().map(|q| q.fixed.x).sum::<f64>() / n;
+            let cy = pts.iter().map(|q| q.fixed.y).sum::<f64>() / n;
+            let range = pts.iter().map(|q| q.range).sum::<f64>() / n;
+            (pts.len() >= p.min_points
+                && width <= p.max_width_m
+                && range >= p.min_range_m
+                && range <= p.max_range_m)
+                .then_some(Blob {
+                    centre: [cx, cy],
+                    left: [first.fixed.x, first.fixed.y],
+                    right: [last.fixed.x, last.fixed.y],
+                    width,
+                    points: pts.len(),
+                    range,
+                })
+        })
+        .collect()
+}
+
+/// The omni image of a scan, with the map from fixed-frame points into its camera frame.
+pub struct OmniFrame<'a> {
+    pub image: &'a RgbImage,
+    pub camera_from_fixed: Isometry3<f64>,
+    pub model: &'a Paracatadioptric,
+}
+
+/// One scan as the follower sees it.
+pub struct ScanObs<'a> {
+    pub t: f64,
+    /// The scan's returns, fixed frame filled in.
+    pub points: &'a [ScanPoint],
+    pub omni: Option<OmniFrame<'a>>,
+}
+
+/// The filter's estimate (fixed frame).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    pub position: [f64; 2],
+    pub velocity: [f64; 2],
+    pub covariance: [[f64; 2]; 2],
+    pub covariance_norm: f64,
+    pub turn_rate: f64,
+    /// IMM mode probabilities [CV, CT].
+    pub modes: Option<[f64; 2]>,
+}
+
+/// What one scan did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepOutput {
+    /// `None` while the target is lost (the robot stops).
+    pub estimate: Option<Estimate>,
+    /// The `rst` rule fired on this scan.
+    pub reset: bool,
+    /// The track was (re-)initialised on this scan.
+    pub initialised: bool,
+    pub blobs: usize,
+    pub gated: usize,
+    pub beta0: Option<f64>,
+    /// The blob with the largest association probability (or the one used).
+    pub chosen: Option<Blob>,
+    /// Its likelihood ratio (1 without colour).
+    pub chosen_lr: Option<f64>,
+}
+
+/// The follower's state.
+pub struct FollowTracker {
+    params: FollowParams,
+    filter: Option<TargetFilter>,
+    template: Option<Vec<f64>>,
+    /// Where to look for the target when there is no track: the initial point, then the last
+    /// estimate before `rst`.
+    anchor: [f64; 2],
+    lost_at: Option<f64>,
+    started: bool,
+    map: Option<CylinderMap>,
+}
+
+impl FollowTracker {
+    /// A follower that starts on the blob nearest `init` (fixed frame).
+    pub fn new(params: &FollowParams, init: [f64; 2]) -> FollowTracker {
+        FollowTracker {
+            params: params.clone(),
+            filter: None,
+            template: None,
+            anchor: init,
+            lost_at: None,
+            started: false,
+            map: None,
+        }
+    }
+
+    pub fn params(&self) -> &FollowParams {
+        &self.params
+    }
+
+    /// Drop the track as `rst` does (e.g. after a filter error): the next scans look for the
+    /// target near its last estimate.
+    pub fn drop_track(&mut self, t: f64) {
+        if let Some(f) = self.filter.take() {
+            self.anchor = f.position();
+        }
+        self.lost_at = Some(t);
+    }
+
+    /// The histogram of each blob, when colour is on and there is an image.
+    fn histograms(&mut self, bl: &[Blob], omni: Option<&OmniFrame<'_>>) -> Vec<Option<Vec<f64>>> {
+        let (true, Some(o)) = (self.params.colour, omni) else {
+            return vec![None; bl.len()];
+        };
+        let [w, h] = self.params.cylinder;
+        let map = match &self.map {
+            Some(m) if m.model == *o.model => m,
+            _ => self.map.insert(CylinderMap::new(o.model, w, h)),
+        };
+        bl.iter()
+            .map(|b| {
+                let roi = cylinder::roi_from_edges(
+                    &o.camera_from_fixed,
+                    b.left,
+                    b.right,
+                    self.params.chest_height_m,
+                    self.params.roi_half_height_m,
+                )?;
+                cylinder::hs_histogram(o.image, map, &roi)
+            })
+            .collect()
+    }
+
+    fn likelihood_ratios(&self, hists: &[Option<Vec<f64>>]) -> Vec<f64> {
+        hists
+            .iter()
+            .map(|h| match (h, &self.template) {
+                (Some(h), Some(t)) => {
+                    cylinder::likelihood_ratio(cylinder::corr(h, t), self.params.corr_min)
+                }
+                _ => 1.0,
+            })
+            .collect()
+    }
+
+    /// Process one scan (see the module doc).
+    pub fn step(&mut self, obs: &ScanObs<'_>) -> Result<StepOutput, FilterError> {
+        let bl = blobs(obs.points, &self.params);
+        let hists = self.histograms(&bl, obs.omni.as_ref());
+        let lr = self.likelihood_ratios(&hists);
+        let mut out = StepOutput {
+            estimate: None,
+            reset: false,
+            initialised: false,
+            blobs: bl.len(),
+            gated: 0,
+            beta0: None,
+            chosen: None,
+            chosen_lr: None,
+        };
+        let Some(filter) = self.filter.as_mut() else {
+            self.initialise(obs.t, &bl, &hists, &lr, &mut out);
+            return Ok(out);
+        };
+        filter.predict(obs.t)?;
+        let z: Vec<[f64; 2]> = bl.iter().map(|b| b.centre).collect();
+        let a = filter.update(&z, &lr)?;
+        out.gated = a.gated.len();
+        out.beta0 = Some(a.beta0);
+        if let Some(j) = a.chosen {
+            out.chosen = bl.get(j).copied();
+            out.chosen_lr = lr.get(j).copied();
+            let w = self.params.template_update;
+            if w > 0.0
+                && let (Some(t), Some(Some(h))) = (self.template.as_mut(), hists.get(j))
+            {
+                t.iter_mut().zip(h).for_each(|(t, h)| *t = (1.0 - w) * *t + w * h);
+            }
+        }
+        if filter.needs_reset() {
+            out.reset = true;
+            self.anchor = filter.position();
+            self.lost_at = Some(obs.t);
+            self.filter = None;
+            return Ok(out);
+        }
+        out.estimate = Some(estimate_of(filter));
+        Ok(out)
+    }
+
+    /// Start (or restart after `rst`) on the nearest plausible blob.
+    fn initialise(
+        &mut self,
+        t: f64,
+        bl: &[Blob],
+        hists: &[Option<Vec<f64>>],
+        lr: &[f64],
+        out: &mut StepOutput,
+    ) {
+        let radius = match (self.started, self.lost_at) {
+            (false, _) => self.params.init_radius_m,
+            (true, lost) => (self.params.reinit_radius_m
+                + self.params.filter.v_max * lost.map_or(0.0, |l| (t - l).max(0.0)))
+            .min(self.params.reinit_max_m),
+        };
+        let d = |b: &Blob| (b.centre[0] - self.anchor[0]).hypot(b.centre[1] - self.anchor[1]);
+        let pick = bl
+            .iter()
+            .enumerate()
+            .filter(|(j, b)| d(b) <= radius && lr.get(*j).is_some_and(|&l| l > 0.0))
+            .min_by(|a, b| d(a.1).total_cmp(&d(b.1)));
+        let Some((j, b)) = pick else { return };
+        let filter = TargetFilter::new(&self.params.filter, t, b.centre);
+        if self.template.is_none()
+            && let Some(Some(h)) = hists.get(j)
+        {
+            self.template = Some(h.clone());
+        }
+        out.initialised = true;
+        out.chosen = Some(*b);
+        out.chosen_lr = lr.get(j).copied();
+        out.estimate = Some(estimate_of(&filter));
+        self.filter = Some(filter);
+        self.started = true;
+        self.lost_at = None;
+    }
+}
+
+fn estimate_of(f: &TargetFilter) -> Estimate {
+    Estimate {
+        position: f.position(),
+        velocity: f.velocity(),
+        covariance: f.position_covariance(),
+        covariance_norm: f.covariance_norm(),
+        turn_rate: f.turn_rate(),
+        modes: f.mode_probabilities(),
+    }
+}
+
+#[cfg(test)]
+mod tests;
