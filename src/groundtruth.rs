@@ -10,6 +10,37 @@ pub const PEOPLE_TOPIC: &str = "/ground_truth/people";
 pub const PEOPLE_SCHEMA: &str = "peopletrack.PeopleGroundTruth";
 pub const TARGETS_TOPIC: &str = "/ground_truth/calibration_targets";
 pub const TARGETS_SCHEMA: &str = "peopletrack.CalibrationTargets";
+pub const FOLLOWER_TOPIC: &str = "/follower/state";
+pub const FOLLOWER_SCHEMA: &str = "peopletrack.FollowerState";
+
+/// `/follower/state`: a following robot's tracker output and command at one scan. Unlike the
+/// ground truth, a real following robot logs this too (seed 001's figures join the robot's
+/// path to each estimate and plot the covariance norm with the `rst` events). Frame `odom`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FollowerState {
+    /// The scan's header stamp (ns).
+    pub stamp_ns: u64,
+    /// Frame of the positions (`odom`).
+    pub frame_id: String,
+    /// Target position (m); `None` (null) while the target is lost.
+    pub position: Option<[f64; 2]>,
+    /// Target velocity (m/s).
+    pub velocity: Option<[f64; 2]>,
+    /// Position covariance (m²).
+    pub covariance: Option<[[f64; 2]; 2]>,
+    /// The track was dropped at this scan to be re-initialised (`rst`).
+    pub reset: bool,
+    /// The following controller (`pursuit`, `direct`).
+    pub controller: String,
+    /// Commanded forward speed (m/s) and yaw rate (rad/s).
+    pub command_v: f64,
+    pub command_w: f64,
+    /// Desired following distance `d_follow + v²/(2·a_min)` (m).
+    pub desired_distance: f64,
+    /// The robot's odometry pose `[x, y, yaw]` at the scan (m, rad).
+    pub robot: [f64; 3],
+}
 
 /// What one camera sees of one person.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -124,6 +155,27 @@ pub const TARGETS_JSON_SCHEMA: &str = r#"{
   }
 }"#;
 
+/// JSON Schema of `/follower/state`.
+pub const FOLLOWER_JSON_SCHEMA: &str = r#"{
+  "$schema": "https://json-schema.org/draft/2020-12/schema",
+  "title": "peopletrack.FollowerState",
+  "type": "object",
+  "required": ["stamp_ns", "frame_id", "position", "velocity", "covariance", "reset", "controller", "command_v", "command_w", "desired_distance", "robot"],
+  "properties": {
+    "stamp_ns": {"type": "integer", "description": "scan stamp (ns)"},
+    "frame_id": {"type": "string", "description": "frame of the positions (odom)"},
+    "position": {"type": ["array", "null"], "items": {"type": "number"}, "minItems": 2, "maxItems": 2, "description": "target position (m), null when lost"},
+    "velocity": {"type": ["array", "null"], "items": {"type": "number"}, "minItems": 2, "maxItems": 2, "description": "target velocity (m/s)"},
+    "covariance": {"type": ["array", "null"], "items": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}, "minItems": 2, "maxItems": 2, "description": "position covariance (m^2)"},
+    "reset": {"type": "boolean", "description": "rst: the track was dropped at this scan"},
+    "controller": {"type": "string", "enum": ["pursuit", "direct"]},
+    "command_v": {"type": "number", "description": "commanded speed (m/s)"},
+    "command_w": {"type": "number", "description": "commanded yaw rate (rad/s)"},
+    "desired_distance": {"type": "number", "description": "d_follow + v^2/(2 a_min) (m)"},
+    "robot": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3, "description": "odometry pose x, y, yaw (m, rad)"}
+  }
+}"#;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -132,6 +184,7 @@ mod tests {
     fn schemas_are_valid_json_and_frames_round_trip() {
         serde_json::from_str::<serde_json::Value>(PEOPLE_JSON_SCHEMA).expect("people schema");
         serde_json::from_str::<serde_json::Value>(TARGETS_JSON_SCHEMA).expect("targets schema");
+        serde_json::from_str::<serde_json::Value>(FOLLOWER_JSON_SCHEMA).expect("follower schema");
         let f = PeopleFrame {
             stamp_ns: 5,
             people: vec![PersonTruth {

@@ -4,7 +4,8 @@
 //!
 //! - [`scenario`]: the file format (world, people, robot, sensors, profiles).
 //! - [`world`]: static scene, moving background, materials and light; [`shapes`]: primitives.
-//! - [`person`]: articulated people; [`motion`]: how they move; [`robot`]: the robot.
+//! - [`person`]: articulated people; [`motion`]: how they move; [`robot`]: the robot;
+//!   [`follow`]: the closed following loop (the robot driven by a tracker's estimate).
 //! - [`render`]: per-pixel ray casting for every camera model; [`laser`]: scans.
 //! - [`session`]: one session written as a log, returning what its preview sheet shows
 //!   ([`PreviewData`]; `report::preview` draws the sheet — the synthesizer draws nothing).
@@ -13,6 +14,7 @@
 //! Not modelled: global illumination, cast shadows other than soft floor shadows under people,
 //! motion blur, rolling shutter, lens vignetting.
 
+pub mod follow;
 pub mod laser;
 pub mod motion;
 pub mod person;

@@ -10,7 +10,7 @@ use rand::RngExt;
 use rand_distr::{Distribution, Normal};
 
 use super::motion::{DT, Track};
-use super::scenario::{Robot, RobotMode};
+use super::scenario::{Follow, Robot, RobotMode};
 use crate::rng;
 
 /// Robot state at one instant.
@@ -44,6 +44,14 @@ pub struct RobotTrack {
 }
 
 impl RobotTrack {
+    /// Whether [`RobotTrack::state`] at `t` interpolates between two held samples (rather
+    /// than holding the last one): true for every `t` of a finished track's duration, and
+    /// what a track still being simulated needs before it is read at `t`.
+    pub fn holds(&self, t: f64) -> bool {
+        let i = (t / DT).max(0.0).floor() as usize;
+        i + 1 < self.samples.len()
+    }
+
     pub fn state(&self, t: f64) -> RobotState {
         let f = (t / DT).max(0.0);
         let i = (f.floor() as usize).min(self.samples.len().saturating_sub(1));
@@ -67,7 +75,24 @@ impl RobotTrack {
     }
 }
 
-fn wrap(a: f64) -> f64 {
+/// Standard deviation of the balancing controller's pitch command noise (rad).
+pub const PITCH_JITTER_RAD: f64 = 0.004;
+
+/// One [`DT`] of a self-balancing base whose speed just changed from `prev_v` to `s.v` (yaw
+/// rate `s.w` set): the acceleration, the pitch's first-order lag (time constant
+/// `pitch_tau_s`) to `pitch_deg_per_mps2 · a` plus `jitter` (rad), then the pose integrated.
+pub fn balance_and_drive(s: &mut RobotState, prev_v: f64, f: &Follow, jitter: f64) {
+    s.accel = (s.v - prev_v) / DT;
+    let pitch_cmd = f.pitch_deg_per_mps2.to_radians() * s.accel + jitter;
+    let prev_pitch = s.pitch;
+    s.pitch += (pitch_cmd - s.pitch) * DT / f.pitch_tau_s;
+    s.pitch_rate = (s.pitch - prev_pitch) / DT;
+    s.x += s.v * s.yaw.cos() * DT;
+    s.y += s.v * s.yaw.sin() * DT;
+    s.yaw = wrap(s.yaw + s.w * DT);
+}
+
+pub(crate) fn wrap(a: f64) -> f64 {
     (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
 }
 
@@ -148,8 +173,7 @@ pub fn simulate(
             let target = target.expect("validated: follow mode has a target track");
             let mut trail: Vec<(f64, f64)> = Vec::new();
             let mut progress = 0usize;
-            let pitch_gain = f.pitch_deg_per_mps2.to_radians();
-            let jitter = Normal::new(0.0, 0.004).expect("valid sigma");
+            let jitter = Normal::new(0.0, PITCH_JITTER_RAD).expect("valid sigma");
             for k in 0..n {
                 samples.push(s);
                 let t = k as f64 * DT;
@@ -190,20 +214,16 @@ pub fn simulate(
                 } * (1.0 - 0.6 * err.abs().min(1.0));
                 let prev_v = s.v;
                 s.v += (v_des - s.v).clamp(-f.max_accel * DT, f.max_accel * DT);
-                s.accel = (s.v - prev_v) / DT;
-                let pitch_cmd = pitch_gain * s.accel + jitter.sample(&mut r);
-                let prev_pitch = s.pitch;
-                s.pitch += (pitch_cmd - s.pitch) * DT / f.pitch_tau_s;
-                s.pitch_rate = (s.pitch - prev_pitch) / DT;
-                s.x += s.v * s.yaw.cos() * DT;
-                s.y += s.v * s.yaw.sin() * DT;
-                s.yaw = wrap(s.yaw + s.w * DT);
+                balance_and_drive(&mut s, prev_v, f, jitter.sample(&mut r));
             }
         }
     }
     let _ = r.random::<u8>();
     RobotTrack { samples }
 }
+
+/// One odometry sample: time (s), pose `[x, y, yaw]` in `odom`, measured speed and yaw rate.
+pub type OdometrySample = (f64, [f64; 3], f64, f64);
 
 /// Odometry pose `(x, y, yaw)` in the `odom` frame at times `t_k = k / rate`, integrating the
 /// true speeds with noise. `odom` starts at the robot's start pose.
@@ -214,33 +234,83 @@ pub fn odometry(
     duration: f64,
     seed: u64,
     session: u64,
-) -> Vec<(f64, [f64; 3], f64, f64)> {
-    let mut r = rng::stream(seed, "odometry", session);
-    let dv = Normal::new(0.0, noise[0].max(0.0)).expect("valid sigma");
-    let dw = Normal::new(0.0, noise[1].max(0.0)).expect("valid sigma");
-    let bias = dv.sample(&mut r); // a wheel-radius error: constant relative speed error
-    let mut out = Vec::new();
-    let (mut x, mut y, mut yaw) = (0.0f64, 0.0f64, 0.0f64);
-    let dt = 1.0 / rate;
-    let mut t = 0.0;
-    while t < duration - 1e-9 {
-        let s = track.state(t);
-        let v = s.v * (1.0 + bias) + 0.2 * dv.sample(&mut r) * s.v.abs();
-        let w = s.w + dw.sample(&mut r);
-        out.push((t, [x, y, yaw], v, w));
-        x += v * yaw.cos() * dt;
-        y += v * yaw.sin() * dt;
-        yaw = wrap(yaw + w * dt);
-        t += dt;
+) -> Vec<OdometrySample> {
+    let mut o = Odometer::new(noise, rate, duration, seed, session);
+    o.advance(track);
+    o.samples
+}
+
+/// Wheel odometry integrated tick by tick as the robot's track grows, so a closed loop reads
+/// at every scan exactly the pose `/odom` will carry ([`odometry`] runs it over a whole track:
+/// the same draws in the same order).
+pub struct Odometer {
+    r: rand_chacha::ChaCha8Rng,
+    dv: Normal<f64>,
+    dw: Normal<f64>,
+    /// A wheel-radius error: a constant relative speed error.
+    bias: f64,
+    pose: [f64; 3],
+    t: f64,
+    dt: f64,
+    duration: f64,
+    /// Every tick integrated so far.
+    pub samples: Vec<OdometrySample>,
+}
+
+impl Odometer {
+    pub fn new(noise: [f64; 2], rate: f64, duration: f64, seed: u64, session: u64) -> Self {
+        let mut r = rng::stream(seed, "odometry", session);
+        let dv = Normal::new(0.0, noise[0].max(0.0)).expect("valid sigma");
+        let dw = Normal::new(0.0, noise[1].max(0.0)).expect("valid sigma");
+        let bias = dv.sample(&mut r);
+        Odometer {
+            r,
+            dv,
+            dw,
+            bias,
+            pose: [0.0; 3],
+            t: 0.0,
+            dt: 1.0 / rate,
+            duration,
+            samples: Vec::new(),
+        }
     }
-    out
+
+    /// Integrate every tick whose true state `track` already holds (both samples around it).
+    pub fn advance(&mut self, track: &RobotTrack) {
+        while self.t < self.duration - 1e-9 && track.holds(self.t) {
+            let s = track.state(self.t);
+            let v = s.v * (1.0 + self.bias) + 0.2 * self.dv.sample(&mut self.r) * s.v.abs();
+            let w = s.w + self.dw.sample(&mut self.r);
+            let [x, y, yaw] = self.pose;
+            self.samples.push((self.t, self.pose, v, w));
+            self.pose = [
+                x + v * yaw.cos() * self.dt,
+                y + v * yaw.sin() * self.dt,
+                wrap(yaw + w * self.dt),
+            ];
+            self.t += self.dt;
+        }
+    }
+
+    /// The odometry pose at `t` and its measured speed: the last tick at or before `t`
+    /// carried forward with that tick's speeds — what interpolating `/odom` (or `odom ->
+    /// base_link` on `/tf`) between its ticks gives. `None` before the first tick.
+    pub fn pose_at(&self, t: f64) -> Option<([f64; 3], f64)> {
+        let k = self.samples.partition_point(|s| s.0 <= t);
+        let (tk, [x, y, yaw], v, w) = *self.samples.get(k.checked_sub(1)?)?;
+        let h = t - tk;
+        Some((
+            [x + v * yaw.cos() * h, y + v * yaw.sin() * h, wrap(yaw + w * h)],
+            v,
+        ))
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::synth::motion::{Goal, walk};
-    use crate::synth::scenario::Follow;
 
     #[test]
     fn follower_keeps_its_distance_and_pitches_when_accelerating() {
@@ -262,6 +332,11 @@ mod tests {
                 max_accel: 1.0,
                 pitch_deg_per_mps2: 6.0,
                 pitch_tau_s: 0.3,
+                closed_loop: false,
+                controllers: vec![],
+                max_decel: None,
+                max_turn_rate: 1.5,
+                estimator: Default::default(),
             }),
             tour: None,
             odom_noise: [0.0, 0.0],

@@ -19,6 +19,7 @@ use crate::time::Nanos;
 
 mod capture;
 mod cast;
+mod following;
 mod odometry;
 mod rig;
 mod truth;
@@ -38,8 +39,10 @@ const EPOCH_S: u64 = 1_700_000_000;
 ///
 /// Stages, in the order they write: the scenario metadata; the sensors (their channels, then
 /// the cameras' true poses as metadata); the TF, odometry, IMU and ground-truth channels and
-/// the static transforms; the robot's odometry and IMU streams; then every sensor capture in
-/// time order, each instant followed by its ground truth.
+/// the static transforms; the robot's odometry and IMU streams; the follower's states (closed
+/// loop only); then every sensor capture in time order, each instant followed by its ground
+/// truth. A closed-loop session runs its following loop (`synth::follow`) after installing the
+/// rig, and everything from the odometry on uses the loop's robot track.
 pub fn write_session(
     s: &Scenario,
     scenario_text: &str,
@@ -55,7 +58,7 @@ pub fn write_session(
     let clock = Clock {
         t0: Nanos((EPOCH_S + 10_000 * session) * Nanos::NANOS_PER_SEC),
     };
-    let (people, robot_track) = cast::people_and_robot(s, &world, base, session)?;
+    let (people, nominal_track) = cast::people_and_robot(s, &world, base, session)?;
 
     let mut w = SessionWriter::create(path, &WriterOptions::default())?;
     let mut meta = BTreeMap::new();
@@ -69,8 +72,26 @@ pub fn write_session(
     meta.insert("scenario_toml".to_string(), scenario_text.to_string());
     w.metadata("peopletrack.scenario", meta)?;
 
-    let mut rig = rig::install(&mut w, s, &world, &robot_track, clock)?;
+    // the rig reads the robot's track only for cameras on a static robot
+    let mut rig = rig::install(&mut w, s, &world, &nominal_track, clock)?;
     let ch = rig::Channels::add(&mut w, s)?;
+    let closed = following::run(
+        &Session {
+            s,
+            world: &world,
+            people: &people,
+            robot_track: &nominal_track,
+            seed,
+            clock,
+            laser_height: rig.laser_height,
+        },
+        &rig,
+        session,
+    )?;
+    let robot_track = match &closed {
+        Some(c) => c.track.clone(),
+        None => nominal_track,
+    };
     w.write(
         ch.tf_static,
         clock.at(0.0),
@@ -80,6 +101,9 @@ pub fn write_session(
     )?;
     odometry::write_odometry(&mut w, &ch, s, &robot_track, session, clock)?;
     odometry::write_imu(&mut w, &ch, s, &robot_track, session, clock)?;
+    if let Some(c) = &closed {
+        following::write_states(&mut w, &ch, c)?;
+    }
 
     let ses = Session {
         s,

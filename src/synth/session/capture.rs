@@ -28,7 +28,7 @@ fn latency(seed: u64, sensor: usize, k: u64, lo_ms: f64, hi_ms: f64) -> u64 {
 }
 
 /// Sensor schedule `(time in ns, sensor index, frame number)`, sorted.
-fn schedule(sensors: &[SensorRuntime], seed: u64, dur: f64) -> Vec<(u64, usize, u64)> {
+pub(super) fn schedule(sensors: &[SensorRuntime], seed: u64, dur: f64) -> Vec<(u64, usize, u64)> {
     let mut events: Vec<(u64, usize, u64)> = Vec::new();
     for (i, sen) in sensors.iter().enumerate() {
         let period = 1.0 / sen.rate();
@@ -119,7 +119,7 @@ pub(super) fn capture_all(
 
 impl Session<'_> {
     /// The scene at `t` with the robot at `base`; `dynamic` is the buffer its primitives live in.
-    fn scene<'d>(
+    pub(super) fn scene<'d>(
         &self,
         t: f64,
         base: Isometry3<f64>,
@@ -166,20 +166,8 @@ impl Session<'_> {
         views: &mut [Vec<CameraView>],
         preview: Option<&mut PreviewData>,
     ) -> Result<(), SynthError> {
-        let (t, stamp) = (scene.t, scene.stamp);
-        let pose = if c.on_robot {
-            scene.base * c.mount
-        } else {
-            c.mount
-        };
-        let frame = c.cam.render(&FrameInput {
-            world: self.world,
-            dynamic: scene.dynamic,
-            shadows: &scene.shadows,
-            t,
-            pose,
-            noise_key: rng::hash(self.seed, &[n, si as u64]),
-        });
+        let stamp = scene.stamp;
+        let (frame, pose) = self.render_camera(c, (si, n), scene);
         let log = Nanos(stamp.0 + latency(self.seed, si, n, 8.0, 25.0));
         write_frame(w, c, &frame, Header::new(stamp, c.frame_id.clone()), log)?;
         // ground-truth views of this camera
@@ -202,6 +190,50 @@ impl Session<'_> {
                 .push((c.frame_id.clone(), pose.translation.vector.into()));
         }
         Ok(())
+    }
+
+    /// Frame `n` of camera `si` at `scene`, and the camera's pose in `map`.
+    pub(super) fn render_camera(
+        &self,
+        c: &CameraSensor,
+        (si, n): (usize, u64),
+        scene: &Scene,
+    ) -> (Frame, Isometry3<f64>) {
+        let pose = if c.on_robot {
+            scene.base * c.mount
+        } else {
+            c.mount
+        };
+        let frame = c.cam.render(&FrameInput {
+            world: self.world,
+            dynamic: scene.dynamic,
+            shadows: &scene.shadows,
+            t: scene.t,
+            pose,
+            noise_key: rng::hash(self.seed, &[n, si as u64]),
+        });
+        (frame, pose)
+    }
+
+    /// Scan `n` of laser `si` at `scene` (ranges as logged), and the laser's pose in `map`.
+    pub(super) fn cast_scan(
+        &self,
+        l: &LaserSensor,
+        (si, n): (usize, u64),
+        scene: &Scene,
+    ) -> (Vec<f32>, Isometry3<f64>) {
+        let pose = if l.on_robot {
+            scene.base * l.mount
+        } else {
+            l.mount
+        };
+        let (ranges, _) = scan(
+            &l.spec,
+            &pose,
+            &[&self.world.statics, scene.dynamic],
+            rng::hash(self.seed, &[n, si as u64, 0x1a5e]),
+        );
+        (ranges, pose)
     }
 
     /// What camera `c` at `pose` saw of each present person: `(slot in states, view)` for
@@ -269,17 +301,7 @@ impl Session<'_> {
     ) -> Result<(), SynthError> {
         let spec = &l.spec;
         let stamp = scene.stamp;
-        let pose = if l.on_robot {
-            scene.base * l.mount
-        } else {
-            l.mount
-        };
-        let (ranges, _) = scan(
-            spec,
-            &pose,
-            &[&self.world.statics, scene.dynamic],
-            rng::hash(self.seed, &[n, si as u64, 0x1a5e]),
-        );
+        let (ranges, pose) = self.cast_scan(l, (si, n), scene);
         if let Some(preview) = preview {
             preview.scan_points = ranges
                 .iter()

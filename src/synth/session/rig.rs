@@ -86,6 +86,8 @@ pub(super) struct Channels {
     pub people: ChannelId,
     /// Calibration targets, when the scenario has a calibration walk.
     pub targets: Option<ChannelId>,
+    /// The follower's state, when the robot follows in a closed loop (added last).
+    pub follower: Option<ChannelId>,
 }
 
 /// Install every sensor of `s`: add its channels to `w`, then write the cameras' true poses
@@ -160,6 +162,17 @@ impl Channels {
             )?),
             None => None,
         };
+        let closed_loop = s.robot.mode == RobotMode::Follow
+            && s.robot.follow.as_ref().is_some_and(|f| f.closed_loop);
+        let follower = if closed_loop {
+            Some(w.add_json(
+                groundtruth::FOLLOWER_TOPIC,
+                groundtruth::FOLLOWER_SCHEMA,
+                groundtruth::FOLLOWER_JSON_SCHEMA,
+            )?)
+        } else {
+            None
+        };
         Ok(Channels {
             tf_static,
             tf,
@@ -167,6 +180,7 @@ impl Channels {
             imu,
             people,
             targets,
+            follower,
         })
     }
 }

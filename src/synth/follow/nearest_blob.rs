@@ -1,0 +1,146 @@
+//! The placeholder baseline estimator of the closed loop (not a paper method): the cluster
+//! of laser returns nearest to the last estimate's prediction, within a gate. It starts on
+//! the cluster nearest to a given point (where a person points the robot at its target),
+//! coasts on its velocity while nothing is in the gate, and after [`LOST_AFTER_S`] without
+//! a return declares the target lost (`rst`): it then answers `None` until a cluster appears
+//! within [`REACQUIRE_M`] of the last estimate. No appearance, no motion model beyond a
+//! smoothed velocity, no data association beyond "nearest": a crosser or a tree can capture
+//! it, which is what the real tracker (seed 001's PDAF) is for.
+
+use nalgebra::Point2;
+
+use super::{Estimate, Follower, FollowerOutput, ScanInput};
+use crate::laser::points::project;
+
+/// Radius of the gate around the predicted position (m).
+pub const GATE_M: f64 = 0.8;
+/// Returns within this distance of the nearest return form the target's cluster: both legs (m).
+pub const CLUSTER_M: f64 = 0.45;
+/// Time without a return in the gate after which the target is lost (s).
+pub const LOST_AFTER_S: f64 = 1.0;
+/// Radius around the initial point, and around the last estimate once lost, in which a
+/// cluster (re)starts the track (m).
+pub const REACQUIRE_M: f64 = 1.5;
+/// Standard deviation of a fresh estimate (m), and its growth per second of coasting (m/s).
+const SIGMA_M: f64 = 0.05;
+const SIGMA_GROWTH_MPS: f64 = 1.0;
+/// Weight of the newest velocity measurement in the smoothed velocity.
+const VELOCITY_GAIN: f64 = 0.3;
+
+struct TrackState {
+    position: [f64; 2],
+    velocity: [f64; 2],
+    /// Time of the last update (s) and of the last return in the gate.
+    t_last: f64,
+    t_seen: f64,
+}
+
+/// See the module doc.
+pub struct NearestBlobFollower {
+    track: Option<TrackState>,
+    /// Where a lost track (or the first scan) looks for its target.
+    anchor: [f64; 2],
+}
+
+impl NearestBlobFollower {
+    pub fn new(init: [f64; 2]) -> Self {
+        NearestBlobFollower {
+            track: None,
+            anchor: init,
+        }
+    }
+}
+
+/// Centroid of the returns within [`CLUSTER_M`] of the return nearest to `at`, when that
+/// return is within `gate` of `at`.
+fn nearest_cluster(points: &[Point2<f64>], at: [f64; 2], gate: f64) -> Option<[f64; 2]> {
+    let at = Point2::new(at[0], at[1]);
+    let nearest = points
+        .iter()
+        .map(|p| ((p - at).norm(), p))
+        .filter(|(d, _)| *d <= gate)
+        .min_by(|a, b| a.0.total_cmp(&b.0))?
+        .1;
+    let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+    for p in points.iter().filter(|p| (*p - nearest).norm() <= CLUSTER_M) {
+        sx += p.x;
+        sy += p.y;
+        n += 1.0;
+    }
+    Some([sx / n, sy / n])
+}
+
+fn estimate(track: &TrackState, t: f64) -> Estimate {
+    let sigma = SIGMA_M + SIGMA_GROWTH_MPS * (t - track.t_seen).max(0.0);
+    Estimate {
+        position: track.position,
+        velocity: track.velocity,
+        covariance: [[sigma * sigma, 0.0], [0.0, sigma * sigma]],
+    }
+}
+
+impl Follower for NearestBlobFollower {
+    fn on_scan(&mut self, input: &ScanInput<'_>) -> FollowerOutput {
+        let t = input.t;
+        let points: Vec<Point2<f64>> =
+            project(input.ranges, &input.geometry, Some(&input.laser_pose))
+                .into_iter()
+                .map(|p| p.fixed)
+                .collect();
+        let Some(tr) = self.track.as_mut() else {
+            // (re)initialise on the cluster nearest to the anchor
+            let Some(c) = nearest_cluster(&points, self.anchor, REACQUIRE_M) else {
+                return FollowerOutput {
+                    estimate: None,
+                    reset: false,
+                };
+            };
+            let tr = TrackState {
+                position: c,
+                velocity: [0.0, 0.0],
+                t_last: t,
+                t_seen: t,
+            };
+            let e = estimate(&tr, t);
+            self.track = Some(tr);
+            return FollowerOutput {
+                estimate: Some(e),
+                reset: false,
+            };
+        };
+        let dt = (t - tr.t_last).max(0.0);
+        let predicted = [
+            tr.position[0] + tr.velocity[0] * dt,
+            tr.position[1] + tr.velocity[1] * dt,
+        ];
+        match nearest_cluster(&points, predicted, GATE_M) {
+            Some(c) if dt > 0.0 => {
+                for k in 0..2 {
+                    let measured = (c[k] - tr.position[k]) / dt;
+                    tr.velocity[k] += VELOCITY_GAIN * (measured - tr.velocity[k]);
+                }
+                tr.position = c;
+                tr.t_seen = t;
+            }
+            Some(_) => tr.t_seen = t,
+            None if t - tr.t_seen > LOST_AFTER_S => {
+                self.anchor = tr.position;
+                self.track = None;
+                return FollowerOutput {
+                    estimate: None,
+                    reset: true,
+                };
+            }
+            None => tr.position = predicted,
+        }
+        tr.t_last = t;
+        FollowerOutput {
+            estimate: Some(estimate(tr, t)),
+            reset: false,
+        }
+    }
+
+    fn uses_omni(&self) -> bool {
+        false
+    }
+}

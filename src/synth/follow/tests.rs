@@ -1,0 +1,369 @@
+//! Known answers of the controllers, the placeholder follower on hand-made scans, and the
+//! closed loop on an analytic laser (a disc for the person) — no renderer, so it is fast.
+
+use std::convert::Infallible;
+
+use nalgebra::{Isometry3, Point3};
+
+use super::closed_loop::{self, CaptureEvent, ClosedLoop, LoopSpec, Sensed, Sensors};
+use super::controller::{self, Limits, OdomPose, Trail};
+use super::nearest_blob::{LOST_AFTER_S, NearestBlobFollower};
+use super::{Estimate, Follower, FollowerOutput, ScanInput};
+use crate::laser::points::ScanGeometry;
+use crate::synth::motion::DT;
+use crate::synth::robot;
+use crate::synth::scenario::{Controller, Estimator, Follow, Robot, RobotMode};
+use crate::time::Nanos;
+
+fn limits() -> Limits {
+    Limits {
+        following_distance: 1.8,
+        max_speed: 2.4,
+        max_accel: 1.4,
+        max_decel: 2.0,
+        max_turn_rate: 1.5,
+    }
+}
+
+fn still(x: f64, y: f64) -> Estimate {
+    Estimate {
+        position: [x, y],
+        velocity: [0.0, 0.0],
+        covariance: [[0.01, 0.0], [0.0, 0.01]],
+    }
+}
+
+fn at_origin(v: f64) -> OdomPose {
+    OdomPose {
+        x: 0.0,
+        y: 0.0,
+        yaw: 0.0,
+        v,
+    }
+}
+
+#[test]
+fn desired_distance_adds_the_stopping_distance() {
+    // d = 1.8 + v²/(2·a_min) = 1.8 + 4/4
+    assert_eq!(limits().desired_distance(2.0), 2.8);
+    assert_eq!(limits().desired_distance(0.0), 1.8);
+}
+
+#[test]
+fn a_still_target_straight_ahead_at_the_desired_distance_needs_no_command() {
+    let lim = limits();
+    for v in [0.0, 1.0] {
+        let robot = at_origin(v);
+        let d = lim.desired_distance(v);
+        let est = still(d, 0.0);
+        let c = controller::direct(&robot, &est, &lim);
+        assert_eq!((c.v, c.w, c.desired_distance), (0.0, 0.0, d));
+        let c = controller::pursuit(&robot, &est, &Trail::default(), &lim);
+        assert_eq!((c.v, c.w), (0.0, 0.0), "pursuit at v = {v}");
+    }
+    // farther: drive; nearer: stand
+    assert!(controller::direct(&at_origin(0.0), &still(3.0, 0.0), &lim).v > 0.0);
+    assert_eq!(controller::direct(&at_origin(0.0), &still(1.0, 0.0), &lim).v, 0.0);
+}
+
+#[test]
+fn the_turn_has_the_sign_of_the_bearing_error() {
+    let lim = limits();
+    let robot = at_origin(1.0);
+    for (y, sign) in [(1.0, 1.0), (-1.0, -1.0)] {
+        let est = still(3.0, y);
+        let c = controller::direct(&robot, &est, &lim);
+        assert_eq!(c.w.signum(), sign, "direct, target at y = {y}");
+        let c = controller::pursuit(&robot, &est, &Trail::default(), &lim);
+        assert_eq!(c.w.signum(), sign, "pursuit, target at y = {y}");
+    }
+    // saturates at the turn-rate limit
+    let c = controller::direct(&robot, &still(-3.0, 0.1), &lim);
+    assert_eq!(c.w, lim.max_turn_rate);
+}
+
+#[test]
+fn pure_pursuit_curvature_of_a_point_on_a_circle_is_its_inverse_radius() {
+    // circle of radius R through the robot, tangent to its heading: centre (0, R)
+    for r in [0.5, 2.0, -3.0] {
+        for phi in [0.1_f64, 0.7, 1.5] {
+            let (x, y) = (r.abs() * phi.sin(), r * (1.0 - phi.cos()));
+            let k = controller::pursuit_curvature(x, y);
+            assert!((k - 1.0 / r).abs() < 1e-12, "R {r} phi {phi}: {k}");
+            assert_eq!(k, 2.0 * y / (x * x + y * y));
+        }
+    }
+    assert_eq!(controller::pursuit_curvature(0.0, 0.0), 0.0);
+}
+
+#[test]
+fn pursuit_aims_along_the_trail_not_at_the_target() {
+    // the person walked up the y axis then turned right: the robot (at the origin, facing +y)
+    // aims at the trail point ahead, straight on, though the target is off to the right
+    let lim = limits();
+    let robot = OdomPose {
+        x: 0.0,
+        y: 0.0,
+        yaw: std::f64::consts::FRAC_PI_2,
+        v: 0.0,
+    };
+    let mut trail = Trail::default();
+    for k in 0..=30 {
+        trail.push([0.0, f64::from(k) * 0.1]);
+    }
+    trail.push([1.0, 3.0]);
+    trail.advance(0.0, 0.0);
+    let est = still(1.5, 3.0);
+    let c = controller::pursuit(&robot, &est, &trail, &lim);
+    assert!(c.w.abs() < 1e-9, "w {}", c.w);
+    // distance along the path 3 + 1.5 = 4.5 m > 1.8 m: drive at K_r·2.7, capped
+    assert_eq!(c.v, lim.max_speed);
+    // direct following turns right, towards the target
+    assert!(controller::direct(&robot, &est, &lim).w < 0.0);
+}
+
+/// A scan of discs (centres in the laser frame, radius) from a laser at the identity pose.
+fn disc_scan(discs: &[([f64; 2], f64)]) -> (Vec<f32>, ScanGeometry) {
+    let g = ScanGeometry {
+        angle_min: -std::f64::consts::FRAC_PI_2,
+        angle_increment: 0.5_f64.to_radians(),
+        range_min: 0.05,
+        range_max: 20.0,
+    };
+    let ranges = (0..361)
+        .map(|k| {
+            let a = g.angle(k);
+            let (dx, dy) = (a.cos(), a.sin());
+            discs
+                .iter()
+                .filter_map(|&([cx, cy], r)| {
+                    let along = cx * dx + cy * dy;
+                    let off2 = cx * cx + cy * cy - along * along;
+                    (off2 <= r * r && along > 0.0).then(|| along - (r * r - off2).sqrt())
+                })
+                .fold(f64::INFINITY, f64::min) as f32
+        })
+        .collect();
+    (ranges, g)
+}
+
+fn input<'a>(t: f64, ranges: &'a [f32], geometry: ScanGeometry) -> ScanInput<'a> {
+    ScanInput {
+        t,
+        stamp: Nanos((t * 1e9) as u64),
+        ranges,
+        geometry,
+        laser_pose: Isometry3::identity(),
+        robot_pose: Isometry3::identity(),
+        omni: None,
+    }
+}
+
+#[test]
+fn nearest_blob_starts_on_the_nearest_cluster_follows_it_and_loses_it() {
+    let legs = |x: f64| [([x, 0.12], 0.06), ([x, -0.12], 0.06)];
+    let tree = ([2.0, 1.5], 0.2);
+    let mut f = NearestBlobFollower::new([2.2, 0.3]);
+    let (r, g) = disc_scan(&[legs(2.0)[0], legs(2.0)[1], tree]);
+    let out = f.on_scan(&input(0.0, &r, g));
+    let e = out.estimate.expect("initialised");
+    // the legs' front surfaces: a little in front of x = 2, between them in y
+    assert!((e.position[0] - 1.96).abs() < 0.04 && e.position[1].abs() < 0.02, "{e:?}");
+    // walking away at 1 m/s, seen every 0.1 s
+    let mut last = e;
+    for k in 1..=10 {
+        let x = 2.0 + 0.1 * f64::from(k);
+        let (r, g) = disc_scan(&[legs(x)[0], legs(x)[1], tree]);
+        last = f
+            .on_scan(&input(0.1 * f64::from(k), &r, g))
+            .estimate
+            .expect("tracked");
+    }
+    assert!((last.position[0] - 2.96).abs() < 0.04, "{last:?}");
+    assert!(last.velocity[0] > 0.5 && last.velocity[0] < 1.1, "{last:?}");
+    // gone: coasts, then `rst` once after LOST_AFTER_S, then nothing
+    let (r, g) = disc_scan(&[tree]);
+    let mut resets = Vec::new();
+    for k in 11..=30 {
+        let t = 0.1 * f64::from(k);
+        let out = f.on_scan(&input(t, &r, g));
+        if out.reset {
+            resets.push(t);
+        }
+        if t <= 1.0 + LOST_AFTER_S - 1e-9 {
+            let e = out.estimate.expect("coasting");
+            assert!(e.covariance[0][0] > last.covariance[0][0]);
+        }
+    }
+    assert_eq!(resets.len(), 1, "{resets:?}");
+    assert!((resets[0] - (1.0 + LOST_AFTER_S + 0.1)).abs() < 1e-9, "{resets:?}");
+    assert_eq!(f.on_scan(&input(3.1, &r, g)).estimate, None);
+}
+
+fn follow_spec() -> Follow {
+    Follow {
+        target: 1,
+        distance: 1.8,
+        max_speed: 2.4,
+        max_accel: 1.4,
+        pitch_deg_per_mps2: 7.0,
+        pitch_tau_s: 0.3,
+        closed_loop: true,
+        controllers: vec![Controller::Pursuit],
+        max_decel: Some(2.0),
+        max_turn_rate: 1.5,
+        estimator: Estimator::NearestBlob,
+    }
+}
+
+fn robot_spec() -> Robot {
+    Robot {
+        mode: RobotMode::Follow,
+        pose: [0.0, 0.0, 0.0],
+        follow: Some(follow_spec()),
+        tour: None,
+        odom_noise: [0.02, 0.01],
+        odom_rate_hz: 50.0,
+        imu_rate_hz: 100.0,
+    }
+}
+
+/// An analytic 10 Hz laser at 0.4 m on the robot that sees one person's legs (discs) walking
+/// along +x at `speed` from (3, 0.5), then a turn to +y at x = 12.
+struct DiscWorld {
+    speed: f64,
+    base_from_laser: Isometry3<f64>,
+}
+
+impl DiscWorld {
+    fn person(&self, t: f64) -> [f64; 2] {
+        let s = self.speed * t;
+        if s < 9.0 { [3.0 + s, 0.5] } else { [12.0, 0.5 + s - 9.0] }
+    }
+}
+
+impl Sensors for DiscWorld {
+    type Error = Infallible;
+
+    fn events(&self, _omni: bool) -> Vec<CaptureEvent> {
+        (0..150)
+            .map(|n| CaptureEvent {
+                t_ns: 3_000_000 + n * 100_000_000,
+                sensor: 0,
+                n,
+                omni: false,
+            })
+            .collect()
+    }
+
+    fn capture(&mut self, ev: &CaptureEvent, map_from_base: &Isometry3<f64>) -> Result<Sensed, Infallible> {
+        let t = ev.t_ns as f64 * 1e-9;
+        let p = self.person(t);
+        let laser_from_map = (map_from_base * self.base_from_laser).inverse();
+        let discs: Vec<([f64; 2], f64)> = [0.12, -0.12]
+            .iter()
+            .map(|dy| {
+                let q = laser_from_map * Point3::new(p[0], p[1] + dy, 0.4);
+                ([q.x, q.y], 0.06)
+            })
+            .collect();
+        let (ranges, geometry) = disc_scan(&discs);
+        Ok(Sensed::Scan {
+            stamp: Nanos(ev.t_ns),
+            ranges,
+            geometry,
+            base_from_laser: self.base_from_laser,
+        })
+    }
+}
+
+fn run_disc_world(controller: Controller, follower: &mut dyn Follower) -> ClosedLoop {
+    let robot = robot_spec();
+    let follow = follow_spec();
+    let spec = LoopSpec {
+        robot: &robot,
+        follow: &follow,
+        controller,
+        duration: 15.0,
+        seed: 7,
+        session: 0,
+    };
+    let mut world = DiscWorld {
+        speed: 1.2,
+        base_from_laser: Isometry3::translation(0.25, 0.0, 0.4),
+    };
+    match closed_loop::run(&spec, &mut world, follower) {
+        Ok(r) => r,
+        Err(e) => match e {},
+    }
+}
+
+#[test]
+fn the_closed_loop_follows_a_walker_with_both_controllers() {
+    let world = DiscWorld {
+        speed: 1.2,
+        base_from_laser: Isometry3::identity(),
+    };
+    for controller in [Controller::Pursuit, Controller::Direct] {
+        let mut f = NearestBlobFollower::new([3.0, 0.5]);
+        let run = run_disc_world(controller, &mut f);
+        assert_eq!(run.scans.len(), 150);
+        assert!(run.scans.iter().all(|s| s.output.estimate.is_some()), "{controller:?} lost it");
+        // after the start-up, the range stays near the following distance and the robot
+        // moves at the walker's speed
+        for t in [6.0, 10.0, 14.0] {
+            let s = run.track.state(t);
+            let p = world.person(t);
+            let range = (p[0] - s.x).hypot(p[1] - s.y);
+            assert!(range > 1.5 && range < 3.5, "{controller:?} t {t}: range {range}");
+        }
+        let s = run.track.state(14.0);
+        assert!((s.v - 1.2).abs() < 0.4, "{controller:?}: v {}", s.v);
+        // it pitched while accelerating
+        let max_pitch = run.track.samples.iter().map(|s| s.pitch).fold(0.0, f64::max);
+        assert!(max_pitch.to_degrees() > 3.0);
+        // the loop's odometry is the one the log gets
+        let odo = robot::odometry(&run.track, [0.02, 0.01], 50.0, 15.0, 7, 0);
+        assert!(odo == run.odometry);
+    }
+}
+
+/// Sees the target straight ahead 3 m away until `lost_at`, then nothing.
+struct LosesAt {
+    lost_at: f64,
+}
+
+impl Follower for LosesAt {
+    fn on_scan(&mut self, input: &ScanInput<'_>) -> FollowerOutput {
+        let ahead = input.robot_pose * Point3::new(3.0, 0.0, 0.0);
+        let seen = input.t < self.lost_at;
+        FollowerOutput {
+            estimate: seen.then(|| still(ahead.x, ahead.y)),
+            reset: (input.t - self.lost_at).abs() < 0.05,
+        }
+    }
+}
+
+#[test]
+fn a_lost_target_stops_the_robot_at_its_deceleration_limit() {
+    let lost_at = 5.0;
+    let run = run_disc_world(Controller::Direct, &mut LosesAt { lost_at });
+    let first_none = run
+        .scans
+        .iter()
+        .find(|s| s.output.estimate.is_none())
+        .expect("lost");
+    assert!(first_none.output.reset);
+    assert_eq!(first_none.command.v, 0.0);
+    let v0 = run.track.state(first_none.t).v;
+    assert!(v0 > 1.0, "moving when lost: {v0}");
+    let stopped_by = first_none.t + v0 / 2.0 + 2.0 * DT;
+    let i = (stopped_by / DT).ceil() as usize;
+    assert_eq!(run.track.samples[i].v, 0.0, "still moving at {stopped_by}");
+    // and not before the deceleration limit allows
+    let early = ((first_none.t + v0 / 2.0 - 3.0 * DT) / DT) as usize;
+    assert!(run.track.samples[early].v > 0.0);
+    // it pitches backwards while braking
+    let min_pitch = run.track.samples[i - 60..i].iter().map(|s| s.pitch).fold(0.0, f64::min);
+    assert!(min_pitch.to_degrees() < -3.0, "{}", min_pitch.to_degrees());
+}
