@@ -337,6 +337,7 @@ mod tests {
                 max_decel: None,
                 max_turn_rate: 1.5,
                 estimator: Default::default(),
+                pdaf: Default::default(),
             }),
             tour: None,
             odom_noise: [0.0, 0.0],

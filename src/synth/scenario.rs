@@ -11,6 +11,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use crate::laser::follow::FollowSpec;
+
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {
     #[error("cannot read scenario {path}: {source}")]
@@ -374,6 +376,9 @@ pub struct Follow {
     /// The target estimator that feeds the closed loop.
     #[serde(default)]
     pub estimator: Estimator,
+    /// Settings of the `pdaf` estimator (every key optional; `laser::follow::FollowSpec`).
+    #[serde(default)]
+    pub pdaf: FollowSpec,
 }
 
 impl Follow {
@@ -421,6 +426,9 @@ pub enum Estimator {
     /// The placeholder baseline: the laser return cluster nearest to the last estimate.
     #[default]
     NearestBlob,
+    /// Seed 001's tracker (`laser::follow`: coordinated-turn PDAF with the colour
+    /// likelihood), with `[robot.follow.pdaf]`'s settings.
+    Pdaf,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -777,8 +785,17 @@ impl Scenario {
     }
 }
 
+/// The first problem of a `[robot.follow]` table's closed-loop keys or of its `pdaf` table:
+/// `(key, reason)`.
+fn follow_problem(f: &Follow, sensors: &[SensorSpec]) -> Option<(String, String)> {
+    if let Some((key, reason)) = f.pdaf.problems().into_iter().next() {
+        return Some((format!("pdaf.{key}"), reason));
+    }
+    loop_problem(f, sensors).map(|(k, r)| (k.to_string(), r))
+}
+
 /// The first problem of a `[robot.follow]` table's closed-loop keys: `(key, reason)`.
-fn follow_problem(f: &Follow, sensors: &[SensorSpec]) -> Option<(&'static str, String)> {
+fn loop_problem(f: &Follow, sensors: &[SensorSpec]) -> Option<(&'static str, String)> {
     if !(f.max_speed > 0.0 && f.max_accel > 0.0) {
         return Some(("max_speed", "max_speed and max_accel must be positive".into()));
     }
@@ -802,3 +819,4 @@ fn follow_problem(f: &Follow, sensors: &[SensorSpec]) -> Option<(&'static str, S
     }
     None
 }
+

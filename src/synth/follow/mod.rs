@@ -9,6 +9,8 @@
 //!   scenario names; the PDAF tracker of `laser` plugs in there (`laser` is a lower layer: the
 //!   synthesizer calls it, never the reverse).
 //! - [`nearest_blob`]: the placeholder baseline estimator (nearest return cluster in a gate).
+//! - [`pdaf`]: the paper's estimator, `laser::follow` in its paper configuration
+//!   (coordinated-turn PDAF with the colour likelihood).
 //! - [`controller`]: direct following and pure pursuit on the estimated path, at the desired
 //!   following distance `d_follow + v²/(2·a_min)` (the term seed 001's `E_follow` subtracts).
 //! - [`closed_loop`]: steps the robot at [`crate::synth::motion::DT`] with the balancing pitch,
@@ -24,6 +26,7 @@
 pub mod closed_loop;
 pub mod controller;
 pub mod nearest_blob;
+pub mod pdaf;
 #[cfg(test)]
 mod tests;
 
@@ -96,5 +99,6 @@ pub trait Follower {
 pub fn make_follower(spec: &Follow, init: [f64; 2]) -> Box<dyn Follower> {
     match spec.estimator {
         Estimator::NearestBlob => Box::new(nearest_blob::NearestBlobFollower::new(init)),
+        Estimator::Pdaf => Box::new(pdaf::PdafFollower::new(&spec.pdaf, init)),
     }
 }
