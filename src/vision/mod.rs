@@ -26,12 +26,16 @@
 //! - [`skin`]: seed 002 §4's skin segmentation (normalised-rgb histogram back-projection,
 //!   smoothing, hysteresis bounded by Canny edges) and the top-fifth person test.
 //! - [`template`]: human-silhouette template detection of seed 004 §3.
+//! - [`egomotion`]: seed 001 §IV's Method 1 — omni image as 8 perspective views, KLT on the
+//!   raw image, bilinear egomotion compensation per view, frame differencing, particle filter
+//!   + EM clustering of the moving region's bearing.
 //!
 //! Kernels read frames and write into buffers the caller owns; nothing here reads logs or
 //! writes files.
 
 pub mod blobs;
 pub mod colortrack;
+pub mod egomotion;
 pub mod ellipse;
 pub mod gabor;
 pub mod gmm;
