@@ -29,6 +29,9 @@
 //! - [`cylinder`]: seed 001 §V's colour feature of a laser blob: the paracatadioptric image on a
 //!   cylinder, the blob's spherical ROI at chest height, hue–saturation histograms, the
 //!   printed correlation and the likelihood ratio.
+//! - [`egomotion`]: seed 001 §IV's Method 1 — omni image as 8 perspective views, KLT on the
+//!   raw image, bilinear egomotion compensation per view, frame differencing, particle filter
+//!   + EM clustering of the moving region's bearing.
 //!
 //! Kernels read frames and write into buffers the caller owns; nothing here reads logs or
 //! writes files.
@@ -36,6 +39,7 @@
 pub mod blobs;
 pub mod colortrack;
 pub mod cylinder;
+pub mod egomotion;
 pub mod ellipse;
 pub mod gabor;
 pub mod gmm;
