@@ -373,13 +373,15 @@ fn run_imm(path: impl Fn(f64) -> [f64; 2], seconds: f64) -> [f64; 2] {
 #[test]
 fn imm_prefers_cv_on_a_line_and_ct_on_a_circle() {
     let line = run_imm(|t| [1.0 + 1.2 * t, -0.5 + 0.4 * t], 6.0);
-    assert!(line[0] > 0.5, "line: {line:?}");
+    // measured: 0.71 after 6 s (the switching keeps it from 1)
+    assert!(line[0] > 0.6, "line: {line:?}");
     let (v, w) = (1.5, 1.2);
     let circle = run_imm(
         |t| [v / w * (w * t).sin(), v / w * (1.0 - (w * t).cos())],
         6.0,
     );
-    assert!(circle[1] > 0.5, "circle: {circle:?}");
+    // measured: 0.77 after 6 s
+    assert!(circle[1] > 0.6, "circle: {circle:?}");
 }
 
 #[test]
