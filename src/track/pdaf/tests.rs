@@ -373,13 +373,15 @@ fn run_imm(path: impl Fn(f64) -> [f64; 2], seconds: f64) -> [f64; 2] {
 #[test]
 fn imm_prefers_cv_on_a_line_and_ct_on_a_circle() {
     let line = run_imm(|t| [1.0 + 1.2 * t, -0.5 + 0.4 * t], 6.0);
-    assert!(line[0] > 0.5, "line: {line:?}");
+    // measured: 0.71 after 6 s (the switching keeps it from 1)
+    assert!(line[0] > 0.6, "line: {line:?}");
     let (v, w) = (1.5, 1.2);
     let circle = run_imm(
         |t| [v / w * (w * t).sin(), v / w * (1.0 - (w * t).cos())],
         6.0,
     );
-    assert!(circle[1] > 0.5, "circle: {circle:?}");
+    // measured: 0.77 after 6 s
+    assert!(circle[1] > 0.6, "circle: {circle:?}");
 }
 
 #[test]
@@ -554,4 +556,34 @@ fn params_read_from_toml_with_defaults() {
     );
     assert_eq!(p.gate, FilterParams::default().gate);
     assert!(toml::from_str::<FilterParams>("sigma = 1.0").is_err());
+}
+
+#[test]
+fn imm_with_nearest_neighbour_follows_a_circle_in_clutter() {
+    let pr = FilterParams {
+        association: AssociationKind::Nearest,
+        sigma_r: 0.05,
+        ..params(ModelKind::Imm)
+    };
+    let (v, w) = (1.5, 1.2);
+    let path = |t: f64| [v / w * (w * t).sin(), v / w * (1.0 - (w * t).cos())];
+    let mut f = TargetFilter::new(&pr, 0.0, path(0.0));
+    for k in 1..=60 {
+        let t = f64::from(k) / 10.0;
+        f.predict(t).expect("predict");
+        let p = path(t);
+        // a blob 0.4 m off the target, and one outside every gate
+        let a = f
+            .update(&[[p[0] + 0.4, p[1]], p, [p[0] + 8.0, p[1]]], &[1.0; 3])
+            .expect("update");
+        assert_eq!((a.chosen, a.beta0), (Some(1), 0.0), "t {t}");
+        assert!(!a.gated.contains(&2));
+        let mu = f.mode_probabilities().expect("imm");
+        assert!((mu[0] + mu[1] - 1.0).abs() < 1e-12);
+    }
+    let mu = f.mode_probabilities().expect("imm");
+    assert!(mu[1] > 0.5, "{mu:?}");
+    let e = f.position();
+    let p = path(6.0);
+    assert!((e[0] - p[0]).hypot(e[1] - p[1]) < 0.05);
 }
