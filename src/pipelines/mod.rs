@@ -3,6 +3,7 @@
 
 pub mod dataset_quality;
 pub mod laser_people;
+pub mod s001_kobilarov_following;
 pub mod s000_cielniak_omni;
 pub mod s002_brooks_height;
 pub mod s003_zivkovic_background;
@@ -50,6 +51,7 @@ registry!(
     dataset_quality::DatasetQuality,
     laser_people::LaserPeople,
     s000_cielniak_omni::OmniAppearance,
+    s001_kobilarov_following::KobilarovFollowing,
     s002_brooks_height::BrooksHeight,
     s003_zivkovic_background::BackgroundTracking,
     s004_mohedano_multicam::MulticamCylinders,

@@ -258,6 +258,9 @@ pub enum Motion {
         speed: [f64; 2],
         #[serde(default)]
         pause_s: [f64; 2],
+        /// Where the walk starts (`[x, y]`); absent: a random point of `area` per session.
+        #[serde(default)]
+        start: Option<[f64; 2]>,
     },
     /// Replay a real trajectory (`frame id x y` at 2.5 Hz, e.g. ../shared/real/eth_ucy/*.txt),
     /// moved by `offset` and turned by `rotate_deg`.

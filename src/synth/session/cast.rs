@@ -160,11 +160,17 @@ fn scripted_track(
             area,
             speed,
             pause_s,
+            start: wander_start,
         } => {
-            let from = start.map(|s| (s.0, s.1)).unwrap_or((
+            // drawn whether used or not, so that datasets without `start` keep their walks
+            let random = (
                 area[0] + r.random::<f64>() * (area[2] - area[0]),
                 area[1] + r.random::<f64>() * (area[3] - area[1]),
-            ));
+            );
+            if start.is_none() {
+                start = wander_start.map(|w| (w[0], w[1], 0.0));
+            }
+            let from = start.map(|s| (s.0, s.1)).unwrap_or(random);
             let from = goals.last().map_or(from, |g| (g.x, g.y));
             goals.extend(motion::wander_goals(
                 from,

@@ -1,0 +1,203 @@
+//! `[params]` of `pipelines/s001_kobilarov_following.toml` and their validation. The paper
+//! gives no filter or detector values; the defaults of [`FollowSpec`] were set a priori (see
+//! `laser::follow` and `track::pdaf`), never searched against the numbers the pipeline reports.
+
+use serde::{Deserialize, Serialize};
+
+use crate::laser::follow::FollowSpec;
+use crate::run::config::Invalid;
+use crate::track::pdaf::{AssociationKind, ModelKind};
+use crate::vision::egomotion::Method1Params;
+
+/// A real laser log run laser-only (no camera in it): its topics.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RealSequence {
+    /// The log's file stem.
+    pub name: String,
+    pub scan_topic: String,
+    /// `leg_tracker/msg/Person` annotations (laser frame).
+    pub gt_topic: String,
+}
+
+/// `[params]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Params {
+    pub scan_topic: String,
+    pub camera: String,
+    /// The closed loop's logged tracker output (JSON, `peopletrack.FollowerState`).
+    pub follower_topic: String,
+    /// Ground-truth id of the followed person.
+    pub target_id: u32,
+    /// The frame the robot tracked in (its odometry), the robot's own frame, and the IMU
+    /// whose roll and pitch tilt it (§III: pitch and roll from the gyros).
+    pub fixed_frame: String,
+    pub base_frame: String,
+    pub imu_topic: String,
+    /// Ground truth joined to a scan by nearest stamp within this (s).
+    pub gt_tolerance_s: f64,
+    /// The robot's following distance d_follow (m) and maximum deceleration a_min (m/s²) of
+    /// E_follow = r − d_follow − v²/(2 a_min): the closed loop's controller settings.
+    pub following_distance_m: f64,
+    pub max_decel_mps2: f64,
+    /// Methods replayed on every log, in table order (see [`method`]).
+    pub methods: Vec<String>,
+    pub follower: FollowSpec,
+    /// A person within this distance (m, beyond their radius) of the laser's line of sight to
+    /// the target, and nearer than it, occludes it.
+    pub occlusion_margin_m: f64,
+    /// An estimate within this distance (m) of a person is locked on that person.
+    pub lock_m: f64,
+    /// Window after an occlusion over which the models' errors are compared (s).
+    pub after_occlusion_s: f64,
+    /// Occlusions shorter than this are not events (s).
+    pub min_occlusion_s: f64,
+    /// Method 1: lost when the bearing is farther than this from the truth (deg), and the
+    /// speed bins of its loss rate (m/s).
+    pub method1_lost_deg: f64,
+    pub method1_speed_bin: f64,
+    /// Every `method1_every`-th omni frame is processed by method 1 (1: all).
+    pub method1_every: usize,
+    pub method1: Method1Params,
+    /// Figures: the fig. 7 window length (s).
+    pub fig7_window_s: f64,
+    pub level: f64,
+    /// Real laser logs (laser only), matched by file stem; SKIPPED when absent.
+    pub real: Vec<RealSequence>,
+    /// Real logs are scored within this distance of the annotation (m; the authors'
+    /// clear_mot.py threshold).
+    pub real_match_m: f64,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            scan_topic: "/scan".into(),
+            camera: "omni_camera".into(),
+            follower_topic: "/follower/state".into(),
+            target_id: 1,
+            fixed_frame: "odom".into(),
+            base_frame: "base_link".into(),
+            imu_topic: "/imu".into(),
+            gt_tolerance_s: 0.06,
+            following_distance_m: 1.8,
+            max_decel_mps2: 1.4,
+            methods: METHODS.iter().map(|m| (*m).to_string()).collect(),
+            follower: FollowSpec::default(),
+            occlusion_margin_m: 0.1,
+            lock_m: 0.5,
+            after_occlusion_s: 2.0,
+            min_occlusion_s: 0.3,
+            method1_lost_deg: 15.0,
+            method1_speed_bin: 0.5,
+            method1_every: 1,
+            method1: Method1Params::default(),
+            fig7_window_s: 30.0,
+            level: 0.95,
+            real: Vec::new(),
+            real_match_m: 0.75,
+        }
+    }
+}
+
+/// One replayed method.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Method {
+    /// The follower of `laser::follow`.
+    Follower {
+        model: ModelKind,
+        association: AssociationKind,
+        colour: bool,
+    },
+    /// The laser issue's multi-person tracker (`laser::tracker`), its track nearest the
+    /// target followed.
+    LaserTracker,
+}
+
+/// The paper's configuration (drives the closed loop): coordinated turn, PDAF, colour.
+pub const PAPER: &str = "ct_colour";
+pub const CV: &str = "cv_colour";
+pub const IMM: &str = "imm_colour";
+pub const NO_COLOUR: &str = "ct_no_colour";
+pub const NN: &str = "nn_ct";
+pub const LASER_TRACKER: &str = "laser_tracker";
+/// Every known method, in the default table order.
+pub const METHODS: [&str; 6] = [PAPER, CV, IMM, NO_COLOUR, NN, LASER_TRACKER];
+
+/// The method a name stands for.
+pub fn method(name: &str) -> Option<Method> {
+    use AssociationKind::{Nearest, Pdaf};
+    use ModelKind::{Ct, Cv, Imm};
+    let f = |model, association, colour| {
+        Some(Method::Follower {
+            model,
+            association,
+            colour,
+        })
+    };
+    match name {
+        PAPER => f(Ct, Pdaf, true),
+        CV => f(Cv, Pdaf, true),
+        IMM => f(Imm, Pdaf, true),
+        NO_COLOUR => f(Ct, Pdaf, false),
+        NN => f(Ct, Nearest, false),
+        LASER_TRACKER => Some(Method::LaserTracker),
+        _ => None,
+    }
+}
+
+impl Params {
+    /// The real sequence a session is, by file stem.
+    pub fn real_sequence(&self, stem: &str) -> Option<&RealSequence> {
+        self.real.iter().find(|r| r.name == stem)
+    }
+}
+
+pub(super) fn validate(p: &Params) -> Vec<Invalid> {
+    let mut out: Vec<Invalid> = Vec::new();
+    for (k, v) in [
+        ("gt_tolerance_s", p.gt_tolerance_s),
+        ("following_distance_m", p.following_distance_m),
+        ("max_decel_mps2", p.max_decel_mps2),
+        ("lock_m", p.lock_m),
+        ("after_occlusion_s", p.after_occlusion_s),
+        ("method1_lost_deg", p.method1_lost_deg),
+        ("method1_speed_bin", p.method1_speed_bin),
+        ("fig7_window_s", p.fig7_window_s),
+        ("real_match_m", p.real_match_m),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            out.push((k.into(), format!("{v} must be finite and > 0")));
+        }
+    }
+    for (k, v) in [
+        ("occlusion_margin_m", p.occlusion_margin_m),
+        ("min_occlusion_s", p.min_occlusion_s),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            out.push((k.into(), format!("{v} must be finite and >= 0")));
+        }
+    }
+    if !(p.level > 0.0 && p.level < 1.0) {
+        out.push(("level".into(), format!("{} is not in (0, 1)", p.level)));
+    }
+    if p.method1_every == 0 {
+        out.push(("method1_every".into(), "0 must be >= 1".into()));
+    }
+    if p.methods.is_empty() {
+        out.push(("methods".into(), "is empty: name at least one method".into()));
+    }
+    for m in &p.methods {
+        if method(m).is_none() {
+            out.push((
+                "methods".into(),
+                format!("unknown method {m:?} (known: {})", METHODS.join(", ")),
+            ));
+        }
+    }
+    for (k, reason) in p.follower.problems() {
+        out.push((format!("follower.{k}"), reason));
+    }
+    out
+}

@@ -1,0 +1,287 @@
+//! Table I of seed 001 and the `rst` events, from the closed loop's ground truth and its
+//! logged tracker output.
+//!
+//! - **Table I** per run (session): r_avg (mean range to the person), b_avg (mean absolute
+//!   bearing, rad), v_avg (mean robot speed), err_avg (mean |E_follow|, E_follow = r − d_follow
+//!   − v²/(2 a_min)), v_max, over every scan where the person exists; then the mean and std rows
+//!   over the runs, as printed; the paper's twelve rows beside them.
+//! - **`rst` events**: every scan where the robot's own tracker dropped its track. Cause, from
+//!   the ground truth of the 3 s before: the condition — laser on the ground (`ground`),
+//!   another person in the line of sight (`occlusion`), target out of the laser's view
+//!   (`out_of_view`) — that held on most of those scans, `other` when none held on 30 % of
+//!   them. Re-acquired right: the first estimate after the reset lies within `lock_m` of the
+//!   person. The paper: 21 resets in 12 runs, 17 re-acquired right, 19 by the ground, 2 by long
+//!   occlusions.
+
+use super::aggregate::SessionData;
+use super::params::Params;
+use super::tables::{LoopRow, TruthRow};
+use crate::eval::stats;
+use crate::report::rows::Rows;
+use crate::report::table::Table;
+use crate::table_row;
+
+/// The paper's Table I: r_avg, b_avg, v_avg, err_avg, v_max of its 12 runs.
+pub const PAPER_TABLE_I: [[f64; 5]; 12] = [
+    [2.91, 0.22, 1.30, 0.70, 2.17],
+    [4.04, 0.16, 1.49, 0.30, 2.25],
+    [3.99, 0.14, 1.49, 0.23, 2.16],
+    [3.74, 0.18, 1.44, 0.15, 1.67],
+    [3.56, 0.15, 1.42, 0.15, 1.77],
+    [5.11, 0.14, 1.72, 0.40, 2.30],
+    [5.46, 0.12, 1.78, 0.44, 2.27],
+    [3.29, 0.14, 1.32, 0.18, 1.71],
+    [4.39, 0.15, 1.56, 0.30, 2.41],
+    [3.91, 0.14, 1.49, 0.24, 2.06],
+    [4.40, 0.12, 1.59, 0.24, 2.06],
+    [3.66, 0.16, 1.38, 0.27, 1.91],
+];
+/// The paper's printed mean and std rows.
+pub const PAPER_MEAN: [f64; 5] = [4.04, 0.15, 1.50, 0.30, 2.06];
+pub const PAPER_STD: [f64; 5] = [0.72, 0.03, 0.15, 0.15, 0.25];
+/// The paper's rst counts: total, re-acquired right, by the ground, by occlusions.
+pub const PAPER_RST: [i64; 4] = [21, 17, 19, 2];
+
+table_row! {
+    /// One row of Table I: `table1`.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct Table1Row {
+        pub source: String,
+        pub run: String,
+        pub controller: String,
+        pub duration_s: Option<f64>,
+        pub r_avg: Option<f64>,
+        pub b_avg: Option<f64>,
+        pub v_avg: Option<f64>,
+        pub err_avg: Option<f64>,
+        pub v_max: Option<f64>,
+    }
+}
+
+table_row! {
+    /// One `rst` event of the closed loop: `rst_events`.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct RstRow {
+        pub run: String,
+        pub t_s: f64,
+        pub cause: String,
+        pub ground_share: f64,
+        pub occlusion_share: f64,
+        pub out_of_view_share: f64,
+        /// Seconds until the robot's tracker had an estimate again (None: never).
+        pub lost_s: Option<f64>,
+        /// `right` (the first estimate after the reset lies on the person), `wrong`, `never`.
+        pub reacquired: String,
+    }
+}
+
+table_row! {
+    /// `rst` counts per run and in all, beside the paper's: `rst_summary`.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct RstSummaryRow {
+        pub source: String,
+        pub run: String,
+        pub rst: i64,
+        pub reacquired_right: i64,
+        pub ground: i64,
+        pub occlusion: i64,
+        pub out_of_view: i64,
+        pub other: i64,
+    }
+}
+
+/// Table I's five values of one run.
+pub fn run_values(truth: &[TruthRow], p: &Params) -> Option<[f64; 5]> {
+    let rows: Vec<&TruthRow> = truth.iter().filter(|r| r.range_m.is_some()).collect();
+    if rows.is_empty() {
+        return None;
+    }
+    let n = rows.len() as f64;
+    let mean = |f: &dyn Fn(&TruthRow) -> f64| rows.iter().map(|r| f(r)).sum::<f64>() / n;
+    let e = |r: &TruthRow| {
+        r.range_m.unwrap_or(0.0)
+            - p.following_distance_m
+            - r.robot_v * r.robot_v / (2.0 * p.max_decel_mps2)
+    };
+    Some([
+        mean(&|r| r.range_m.unwrap_or(0.0)),
+        mean(&|r| r.bearing_rad.unwrap_or(0.0).abs()),
+        mean(&|r| r.robot_v),
+        mean(&|r| e(r).abs()),
+        rows.iter().map(|r| r.robot_v).fold(0.0, f64::max),
+    ])
+}
+
+fn row(source: &str, run: &str, controller: &str, d: Option<f64>, v: Option<[f64; 5]>) -> Table1Row {
+    Table1Row {
+        source: source.into(),
+        run: run.into(),
+        controller: controller.into(),
+        duration_s: d,
+        r_avg: v.map(|v| v[0]),
+        b_avg: v.map(|v| v[1]),
+        v_avg: v.map(|v| v[2]),
+        err_avg: v.map(|v| v[3]),
+        v_max: v.map(|v| v[4]),
+    }
+}
+
+/// Table I: ours per run, mean and std, then the paper's.
+pub fn table1_rows(data: &[&SessionData], p: &Params) -> Vec<Table1Row> {
+    let mut out = Vec::new();
+    let mut values = Vec::new();
+    for d in data {
+        let v = run_values(&d.truth, p);
+        values.extend(v);
+        let controller = d.closed_loop.first().map_or("", |r| r.controller.as_str());
+        let dur = d.truth.last().map(|r| r.t_s);
+        out.push(row("ours", &d.name, controller, dur, v));
+    }
+    let col = |i: usize| values.iter().map(|v| v[i]).collect::<Vec<f64>>();
+    let summaries: Vec<Option<stats::Summary>> = (0..5).map(|i| stats::describe(&col(i)).ok()).collect();
+    let pick = |f: fn(&stats::Summary) -> f64| {
+        let v: Vec<Option<f64>> = summaries.iter().map(|s| s.as_ref().map(f)).collect();
+        v.iter().all(Option::is_some).then(|| [0, 1, 2, 3, 4].map(|i| v[i].unwrap_or(f64::NAN)))
+    };
+    out.push(row("ours", "mean", "", None, pick(|s| s.mean)));
+    out.push(row("ours", "std", "", None, pick(|s| s.std)));
+    for (i, v) in PAPER_TABLE_I.iter().enumerate() {
+        out.push(row("paper", &format!("run {}", i + 1), "", None, Some(*v)));
+    }
+    out.push(row("paper", "mean", "", None, Some(PAPER_MEAN)));
+    out.push(row("paper", "std", "", None, Some(PAPER_STD)));
+    out
+}
+
+/// The `rst` events of one run (see the module doc).
+pub fn events(d: &SessionData, p: &Params) -> Vec<RstRow> {
+    let mut out = Vec::new();
+    for (i, r) in d.closed_loop.iter().enumerate().filter(|(_, r)| r.reset) {
+        let before: Vec<&TruthRow> = d
+            .truth
+            .iter()
+            .filter(|q| q.t_s <= r.t_s && q.t_s > r.t_s - 3.0)
+            .collect();
+        let n = before.len().max(1) as f64;
+        let share = |f: fn(&TruthRow) -> bool| before.iter().filter(|q| f(q)).count() as f64 / n;
+        let (g, o, v) = (share(|q| q.ground), share(|q| q.occluded), share(|q| q.out_of_view));
+        let cause = if g.max(o).max(v) < 0.3 {
+            "other"
+        } else if g >= o && g >= v {
+            "ground"
+        } else if o >= v {
+            "occlusion"
+        } else {
+            "out_of_view"
+        };
+        let back = d.closed_loop[i + 1..].iter().find(|q| q.x.is_some());
+        let reacquired = match back.and_then(|q| reacquired_right(q, &d.truth, p)) {
+            Some(true) => "right",
+            Some(false) => "wrong",
+            None => "never",
+        };
+        out.push(RstRow {
+            run: d.name.clone(),
+            t_s: r.t_s,
+            cause: cause.into(),
+            ground_share: g,
+            occlusion_share: o,
+            out_of_view_share: v,
+            lost_s: back.map(|q| q.t_s - r.t_s),
+            reacquired: reacquired.into(),
+        });
+    }
+    out
+}
+
+fn reacquired_right(q: &LoopRow, truth: &[TruthRow], p: &Params) -> Option<bool> {
+    let t = truth
+        .iter()
+        .min_by(|a, b| (a.t_s - q.t_s).abs().total_cmp(&(b.t_s - q.t_s).abs()))?;
+    let (x, y) = (q.x?, q.y?);
+    Some((t.target_x? - x).hypot(t.target_y? - y) <= p.lock_m)
+}
+
+fn summary_row(source: &str, run: &str, ev: &[RstRow]) -> RstSummaryRow {
+    let count = |c: &str| ev.iter().filter(|e| e.cause == c).count() as i64;
+    RstSummaryRow {
+        source: source.into(),
+        run: run.into(),
+        rst: ev.len() as i64,
+        reacquired_right: ev.iter().filter(|e| e.reacquired == "right").count() as i64,
+        ground: count("ground"),
+        occlusion: count("occlusion"),
+        out_of_view: count("out_of_view"),
+        other: count("other"),
+    }
+}
+
+/// Table I, the `rst` events and their summary.
+pub fn tables(data: &[&SessionData], p: &Params) -> anyhow::Result<Vec<Table>> {
+    let mut t1 = Table::new(
+        "table1",
+        "Table I: averaged estimates per run (r range, b |bearing|, v robot speed, err |E_follow|, v_max), ours beside the paper's",
+        super::table1::Table1Row::frame(&table1_rows(data, p))?,
+    );
+    for c in ["duration_s", "r_avg", "b_avg", "v_avg", "err_avg", "v_max"] {
+        t1 = t1.with_precision(c, 2);
+    }
+    let t1 = t1.with_note(format!(
+        "Ours: the closed loop's ground truth at every scan where the person exists (robot pose map <- base_link, exact in the synthesizer). E_follow = r - d_follow - v^2/(2 a_min) with d_follow = {} m, a_min = {} m/s^2 (the controller's settings). b in rad. Paper: 12 runs of 2-3 min in a park, Segway RMP.",
+        p.following_distance_m, p.max_decel_mps2
+    ));
+    let ev: Vec<RstRow> = data.iter().flat_map(|d| events(d, p)).collect();
+    let mut te = Table::new(
+        "rst_events",
+        "rst events of the closed loop: cause from the ground truth of the 3 s before, re-acquisition",
+        RstRow::frame(&ev)?,
+    );
+    for c in ["t_s", "ground_share", "occlusion_share", "out_of_view_share", "lost_s"] {
+        te = te.with_precision(c, 2);
+    }
+    let mut sum: Vec<RstSummaryRow> = data
+        .iter()
+        .map(|d| {
+            let e: Vec<RstRow> = ev.iter().filter(|e| e.run == d.name).cloned().collect();
+            summary_row("ours", &d.name, &e)
+        })
+        .collect();
+    sum.push(summary_row("ours", "all", &ev));
+    sum.push(RstSummaryRow {
+        source: "paper".into(),
+        run: "12 runs".into(),
+        rst: PAPER_RST[0],
+        reacquired_right: PAPER_RST[1],
+        ground: PAPER_RST[2],
+        occlusion: PAPER_RST[3],
+        out_of_view: 0,
+        other: 0,
+    });
+    let ts = Table::new(
+        "rst_summary",
+        "rst conditions per run and in all, beside the paper's (21 rst, 17 re-acquired right, 19 by the ground, 2 by occlusions)",
+        RstSummaryRow::frame(&sum)?,
+    );
+    Ok(vec![t1, te, ts])
+}
+
+/// Report lines: Table I's mean row beside the paper's, the rst counts.
+pub fn summary(data: &[&SessionData], p: &Params) -> Vec<String> {
+    let rows = table1_rows(data, p);
+    let mut out = Vec::new();
+    if let Some(m) = rows.iter().find(|r| r.source == "ours" && r.run == "mean")
+        && let (Some(r), Some(b), Some(v), Some(e), Some(x)) = (m.r_avg, m.b_avg, m.v_avg, m.err_avg, m.v_max)
+    {
+        out.push(format!(
+            "Table I over {} runs: r_avg {r:.2} m, b_avg {b:.2} rad, v_avg {v:.2} m/s, err_avg {e:.2} m, v_max {x:.2} m/s (paper: 4.04, 0.15, 1.50, 0.30, 2.06)",
+            data.len()
+        ));
+    }
+    let ev: Vec<RstRow> = data.iter().flat_map(|d| events(d, p)).collect();
+    let s = summary_row("ours", "all", &ev);
+    out.push(format!(
+        "rst: {} ({} re-acquired the right person; ground {}, occlusion {}, out of view {}, other {}); paper: 21 (17; ground 19, occlusion 2)",
+        s.rst, s.reacquired_right, s.ground, s.occlusion, s.out_of_view, s.other
+    ));
+    out
+}
