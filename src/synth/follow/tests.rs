@@ -85,7 +85,7 @@ fn the_turn_has_the_sign_of_the_bearing_error() {
 #[test]
 fn pure_pursuit_curvature_of_a_point_on_a_circle_is_its_inverse_radius() {
     // circle of radius R through the robot, tangent to its heading: centre (0, R)
-    for r in [0.5, 2.0, -3.0] {
+    for r in [0.5_f64, 2.0, -3.0] {
         for phi in [0.1_f64, 0.7, 1.5] {
             let (x, y) = (r.abs() * phi.sin(), r * (1.0 - phi.cos()));
             let k = controller::pursuit_curvature(x, y);
