@@ -7,7 +7,7 @@
 //! - [`pursuit`]: pure pursuit on the person's estimated path: aim at the first trail point at
 //!   least [`LOOKAHEAD_M`] away, `ω = κ·v` with the curvature `κ = 2·y/L²` of the arc through
 //!   it (`y` its lateral offset, `L` its distance); drive to null the error of the distance
-//!   *along the path* to the target.
+//!   *along the path* to the target (the straight range once that is below `d`).
 //!
 //! Both keep the desired following distance `d = d_follow + v²/(2·a_min)` (`v` the robot's
 //! speed, `a_min` its largest deceleration: the term seed 001's `E_follow` subtracts, so the
@@ -139,11 +139,13 @@ impl Trail {
         }
     }
 
-    /// Pass the points the robot at `(x, y)` came within [`TRAIL_REACHED_M`] of.
+    /// Pass the points the robot at `(x, y)` came within [`TRAIL_REACHED_M`] of, and those
+    /// whose successor is nearer to it (the robot is already beyond them).
     pub fn advance(&mut self, x: f64, y: f64) {
+        let dist = |p: [f64; 2]| (p[0] - x).hypot(p[1] - y);
         while self.progress + 1 < self.points.len() {
-            let p = self.points[self.progress];
-            if (p[0] - x).hypot(p[1] - y) >= TRAIL_REACHED_M {
+            let (p, q) = (self.points[self.progress], self.points[self.progress + 1]);
+            if dist(p) >= TRAIL_REACHED_M && dist(q) > dist(p) {
                 break;
             }
             self.progress += 1;
@@ -181,6 +183,9 @@ pub fn pursuit(robot: &OdomPose, est: &Estimate, trail: &Trail, lim: &Limits) ->
         from = p;
     }
     along += dist(from, target);
+    // never close in below the following distance, however long the path
+    let range = dist(here, target);
+    let gap = if range <= d { range - d } else { along - d };
     let goal = ahead
         .iter()
         .copied()
@@ -191,7 +196,7 @@ pub fn pursuit(robot: &OdomPose, est: &Estimate, trail: &Trail, lim: &Limits) ->
     let (x, y) = (c * gx + s * gy, -s * gx + c * gy);
     let bearing = y.atan2(x);
     let speed_t = est.velocity[0].hypot(est.velocity[1]);
-    let v = ((K_RANGE * (along - d) + speed_t) * heading_factor(bearing)).clamp(0.0, lim.max_speed);
+    let v = ((K_RANGE * gap + speed_t) * heading_factor(bearing)).clamp(0.0, lim.max_speed);
     let w = if x > 0.0 {
         pursuit_curvature(x, y) * v.max(PURSUIT_MIN_TURN_SPEED)
     } else {

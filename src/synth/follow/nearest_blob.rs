@@ -3,7 +3,9 @@
 //! the cluster nearest to a given point (where a person points the robot at its target),
 //! coasts on its velocity while nothing is in the gate, and after [`LOST_AFTER_S`] without
 //! a return declares the target lost (`rst`): it then answers `None` until a cluster appears
-//! within [`REACQUIRE_M`] of the last estimate. No appearance, no motion model beyond a
+//! within [`REACQUIRE_M`] (growing by [`REACQUIRE_GROWTH_MPS`] per second since the loss) of
+//! where the last estimate would have walked to; the first search, around the initial point,
+//! grows the same way from t = 0. No appearance, no motion model beyond a
 //! smoothed velocity, no data association beyond "nearest": a crosser or a tree can capture
 //! it, which is what the real tracker (seed 001's PDAF) is for.
 
@@ -21,6 +23,11 @@ pub const LOST_AFTER_S: f64 = 1.0;
 /// Radius around the initial point, and around the last estimate once lost, in which a
 /// cluster (re)starts the track (m).
 pub const REACQUIRE_M: f64 = 1.5;
+/// Growth of the reacquisition radius per second since the target was lost (m/s): about a
+/// walker's speed, as the person walks on while the robot stops.
+pub const REACQUIRE_GROWTH_MPS: f64 = 1.5;
+/// Largest reacquisition radius (m).
+pub const REACQUIRE_MAX_M: f64 = 6.0;
 /// Standard deviation of a fresh estimate (m), and its growth per second of coasting (m/s).
 const SIGMA_M: f64 = 0.05;
 const SIGMA_GROWTH_MPS: f64 = 1.0;
@@ -38,16 +45,26 @@ struct TrackState {
 /// See the module doc.
 pub struct NearestBlobFollower {
     track: Option<TrackState>,
-    /// Where a lost track (or the first scan) looks for its target.
-    anchor: [f64; 2],
+    /// Where a lost (or not yet found) target is searched for: its last position and velocity
+    /// and the time it was lost (the initial point counts as lost at t = 0).
+    anchor: ([f64; 2], [f64; 2], f64),
 }
 
 impl NearestBlobFollower {
     pub fn new(init: [f64; 2]) -> Self {
         NearestBlobFollower {
             track: None,
-            anchor: init,
+            anchor: (init, [0.0, 0.0], 0.0),
         }
+    }
+
+    /// Centre and radius of the search for a lost (or not yet found) target at `t`.
+    fn search(&self, t: f64) -> ([f64; 2], f64) {
+        let (p, v, t0) = self.anchor;
+        let h = (t - t0).max(0.0);
+        let r = (REACQUIRE_M + REACQUIRE_GROWTH_MPS * h).min(REACQUIRE_MAX_M);
+        let h = h.min(LOST_AFTER_S);
+        ([p[0] + v[0] * h, p[1] + v[1] * h], r)
     }
 }
 
@@ -89,7 +106,8 @@ impl Follower for NearestBlobFollower {
                 .collect();
         let Some(tr) = self.track.as_mut() else {
             // (re)initialise on the cluster nearest to the anchor
-            let Some(c) = nearest_cluster(&points, self.anchor, REACQUIRE_M) else {
+            let (centre, radius) = self.search(t);
+            let Some(c) = nearest_cluster(&points, centre, radius) else {
                 return FollowerOutput {
                     estimate: None,
                     reset: false,
@@ -124,7 +142,7 @@ impl Follower for NearestBlobFollower {
             }
             Some(_) => tr.t_seen = t,
             None if t - tr.t_seen > LOST_AFTER_S => {
-                self.anchor = tr.position;
+                self.anchor = (tr.position, tr.velocity, t);
                 self.track = None;
                 return FollowerOutput {
                     estimate: None,

@@ -1,0 +1,125 @@
+//! `[robot.follow]`: the following robot's parameters — its target, following distance and
+//! limits, and the closed loop's keys (`closed_loop`, `controllers`, `max_decel`,
+//! `max_turn_rate`, `estimator`; see `synth::follow`).
+
+use serde::{Deserialize, Serialize};
+
+use super::{MountFrame, SensorSpec};
+use crate::laser::follow::FollowSpec;
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Follow {
+    pub target: u32,
+    pub distance: f64,
+    pub max_speed: f64,
+    pub max_accel: f64,
+    /// Body pitch per m/s² of acceleration (a self-balancing base leans into acceleration).
+    #[serde(default)]
+    pub pitch_deg_per_mps2: f64,
+    #[serde(default = "default_pitch_tau")]
+    pub pitch_tau_s: f64,
+    /// Drive the robot from a tracker's estimate at every scan (`synth::follow`) instead of
+    /// from the target's true track. Off by default: open-loop datasets stay as they were.
+    #[serde(default)]
+    pub closed_loop: bool,
+    /// Following controllers of the closed loop, cycled by session index.
+    #[serde(default = "default_controllers")]
+    pub controllers: Vec<Controller>,
+    /// `a_min` of seed 001 (m/s²): the largest deceleration; `None`: `max_accel`.
+    pub max_decel: Option<f64>,
+    /// Turn-rate limit of the closed loop (rad/s).
+    #[serde(default = "default_max_turn_rate")]
+    pub max_turn_rate: f64,
+    /// The target estimator that feeds the closed loop.
+    #[serde(default)]
+    pub estimator: Estimator,
+    /// Settings of the `pdaf` estimator (every key optional; `laser::follow::FollowSpec`).
+    #[serde(default)]
+    pub pdaf: FollowSpec,
+}
+
+impl Follow {
+    /// `a_min`: the largest deceleration (m/s²).
+    pub fn decel(&self) -> f64 {
+        self.max_decel.unwrap_or(self.max_accel)
+    }
+}
+
+fn default_pitch_tau() -> f64 {
+    0.3
+}
+
+fn default_max_turn_rate() -> f64 {
+    1.5
+}
+
+fn default_controllers() -> Vec<Controller> {
+    vec![Controller::Pursuit, Controller::Direct]
+}
+
+/// A following controller of seed 001 §VI.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Controller {
+    /// Pure pursuit along the person's estimated path.
+    Pursuit,
+    /// Minimise the relative bearing and the range error.
+    Direct,
+}
+
+impl Controller {
+    pub fn name(self) -> &'static str {
+        match self {
+            Controller::Pursuit => "pursuit",
+            Controller::Direct => "direct",
+        }
+    }
+}
+
+/// The estimator of the target that the closed loop follows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Estimator {
+    /// The placeholder baseline: the laser return cluster nearest to the last estimate.
+    #[default]
+    NearestBlob,
+    /// Seed 001's tracker (`laser::follow`: coordinated-turn PDAF with the colour
+    /// likelihood), with `[robot.follow.pdaf]`'s settings.
+    Pdaf,
+}
+
+/// The first problem of a `[robot.follow]` table's closed-loop keys or of its `pdaf` table:
+/// `(key, reason)`.
+pub(super) fn follow_problem(f: &Follow, sensors: &[SensorSpec]) -> Option<(String, String)> {
+    if let Some((key, reason)) = f.pdaf.problems().into_iter().next() {
+        return Some((format!("pdaf.{key}"), reason));
+    }
+    loop_problem(f, sensors).map(|(k, r)| (k.to_string(), r))
+}
+
+/// The first problem of a `[robot.follow]` table's closed-loop keys: `(key, reason)`.
+fn loop_problem(f: &Follow, sensors: &[SensorSpec]) -> Option<(&'static str, String)> {
+    if !(f.max_speed > 0.0 && f.max_accel > 0.0) {
+        return Some(("max_speed", "max_speed and max_accel must be positive".into()));
+    }
+    if f.max_decel.is_some_and(|a| !(a > 0.0 && a.is_finite())) {
+        return Some(("max_decel", format!("{:?} is not a positive deceleration", f.max_decel)));
+    }
+    if !(f.max_turn_rate > 0.0 && f.max_turn_rate.is_finite()) {
+        return Some(("max_turn_rate", format!("{} is not positive", f.max_turn_rate)));
+    }
+    if f.controllers.is_empty() {
+        return Some(("controllers", "name at least one of \"pursuit\", \"direct\"".into()));
+    }
+    let robot_laser = sensors
+        .iter()
+        .any(|x| matches!(x, SensorSpec::Laser { mount, .. } if mount.on == MountFrame::Robot));
+    if f.closed_loop && !robot_laser {
+        return Some((
+            "closed_loop",
+            "the closed loop needs a laser mounted on the robot".into(),
+        ));
+    }
+    None
+}
