@@ -27,7 +27,7 @@ use super::EgomotionError;
 use crate::geometry::camera::{Paracatadioptric, Pinhole};
 
 /// How the ring of perspective views is laid out.
-#[derive(Debug, Clone, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ViewParams {
     /// Number of views, axes equally spaced in azimuth (paper: 45° apart, so 8).
@@ -187,7 +187,7 @@ impl Views {
         if !(p.hfov_deg > 0.0 && p.hfov_deg < 170.0) {
             return Err(bad("hfov_deg must be in (0, 170)"));
         }
-        if !(p.elevation_deg.abs() < 80.0) {
+        if p.elevation_deg.is_nan() || p.elevation_deg.abs() >= 80.0 {
             return Err(bad("elevation_deg must be in (-80, 80)"));
         }
         let step = std::f64::consts::TAU / p.count as f64;
