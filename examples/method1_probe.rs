@@ -27,6 +27,8 @@ const THRESHOLDS: [f64; 2] = [0.1745, 0.349];
 struct Sample {
     speed: f64,
     error: Option<f64>,
+    /// The target's visible fraction in the omni image (ground truth; 0 when not listed).
+    visibility: f64,
 }
 
 /// Truth check: the TF-derived bearing against the bearing of the person's projected head in
@@ -138,7 +140,16 @@ fn session(path: &str, seed: u64, dump_dir: Option<&str>) -> Res<(Vec<Sample>, [
                 res.detection.map(|d| d.azimuth),
             )?;
         }
-        out.push(Sample { speed, error });
+        let visibility = p
+            .cameras
+            .iter()
+            .find(|c| c.camera == CAMERA)
+            .map_or(0.0, |c| c.visibility);
+        out.push(Sample {
+            speed,
+            error,
+            visibility,
+        });
     }
     println!(
         "{path}: truth check, TF bearing vs head_px bearing: worst {:.2} deg",
@@ -188,8 +199,16 @@ fn main() -> Res<()> {
             .map(|s| (s.speed, is_lost(s.error, 0.0, th)))
             .collect();
         let total = lost.iter().filter(|l| l.1).count();
+        let visible: Vec<&Sample> = all.iter().filter(|s| s.visibility >= 0.5).collect();
+        let lost_visible = visible.iter().filter(|s| is_lost(s.error, 0.0, th)).count();
         println!(
-            "\nthreshold {:.0} deg: lost {total} of {} frames ({:.1} %)",
+            "\nthreshold {:.0} deg: a uniformly random bearing would be lost in {:.1} % of frames; frames with the target at least half visible: {} ({lost_visible} lost)",
+            th.to_degrees(),
+            100.0 * (1.0 - th / std::f64::consts::PI),
+            visible.len()
+        );
+        println!(
+            "threshold {:.0} deg: lost {total} of {} frames ({:.1} %)",
             th.to_degrees(),
             lost.len(),
             100.0 * total as f64 / lost.len().max(1) as f64
