@@ -5,7 +5,9 @@
 //! robot-speed bin (0.25 m/s) at two loss thresholds. A measurement, never a tuning loop: the
 //! parameters are `Method1Params::default()`.
 //!
-//! Usage: `cargo run --release --example method1_probe [-- LOG.mcap …]`
+//! Usage: `cargo run --release --example method1_probe [-- [--dump DIR] LOG.mcap …]`
+//! (`--dump`: every 20th frame's omni image with the true and detected bearings, and the
+//! difference views, as PNGs in DIR)
 //! (default: `datasets/segway_park/segway_park_00.mcap` and `_01`).
 
 use nalgebra::Point3;
@@ -25,9 +27,56 @@ const THRESHOLDS: [f64; 2] = [0.1745, 0.349];
 struct Sample {
     speed: f64,
     error: Option<f64>,
+    /// The target's visible fraction in the omni image (ground truth; 0 when not listed).
+    visibility: f64,
 }
 
-fn session(path: &str, seed: u64) -> Res<(Vec<Sample>, [f64; 3])> {
+/// Truth check: the TF-derived bearing against the bearing of the person's projected head in
+/// the omni image (ground truth's `head_px`): largest difference seen (rad).
+fn head_px_bearing(p: &peopletrack::groundtruth::PersonTruth, xc: f64, yc: f64) -> Option<f64> {
+    let v = p.cameras.iter().find(|c| c.camera == CAMERA)?;
+    let h = v.head_px?;
+    Some((h[1] - yc).atan2(h[0] - xc))
+}
+
+/// Writes the omni image with the true (green) and detected (red) bearings drawn as rays from
+/// the centre, and the 8 difference views side by side.
+fn dump(
+    dir: &str,
+    k: usize,
+    rgb: &image::RgbImage,
+    m: &Method1,
+    true_az: f64,
+    det: Option<f64>,
+) -> Res<()> {
+    let model = m.views().omni();
+    let mut img = rgb.clone();
+    for (az, colour) in [(Some(true_az), [0, 255, 0]), (det, [255, 0, 0])] {
+        let Some(az) = az else { continue };
+        for r in (model.r_min as i32)..(model.r_max as i32) {
+            let (x, y) = (
+                model.xc + f64::from(r) * az.cos(),
+                model.yc + f64::from(r) * az.sin(),
+            );
+            if x >= 0.0 && y >= 0.0 && (x as u32) < img.width() && (y as u32) < img.height() {
+                img.put_pixel(x as u32, y as u32, image::Rgb(colour));
+            }
+        }
+    }
+    img.save(format!("{dir}/omni_{k:04}.png"))?;
+    let d = m.differences();
+    if let Some(first) = d.first() {
+        let (w, h) = (first.width as u32, first.height as u32);
+        let tiles = image::GrayImage::from_fn(w * d.len() as u32, h, |x, y| {
+            let p = &d[(x / w) as usize];
+            image::Luma([p.at((x % w) as usize, y as usize).min(255.0) as u8])
+        });
+        tiles.save(format!("{dir}/diff_{k:04}.png"))?;
+    }
+    Ok(())
+}
+
+fn session(path: &str, seed: u64, dump_dir: Option<&str>) -> Res<(Vec<Sample>, [f64; 3])> {
     let log = SessionLog::open(path)?;
     let tf = TfBuffer::from_log(&log, 0.0)?;
     let cam = rig::camera(
@@ -47,6 +96,7 @@ fn session(path: &str, seed: u64) -> Res<(Vec<Sample>, [f64; 3])> {
     let mut m = Method1::new(&model, &Method1Params::default(), seed)?;
     let mut out = Vec::new();
     let (mut features, mut fallbacks, mut steps) = (0usize, 0usize, 0usize);
+    let mut worst_truth_check = 0.0f64;
     for f in &mut camera::frames(&log, &topic, None)? {
         let f = f?;
         let res = m.step(&f.rgb)?;
@@ -67,6 +117,10 @@ fn session(path: &str, seed: u64) -> Res<(Vec<Sample>, [f64; 3])> {
         };
         let q = map_from_cam.inverse_transform_point(&Point3::new(p.x, p.y, 0.6 * p.height));
         let true_az = q.y.atan2(q.x);
+        if let Some(b) = head_px_bearing(p, model.xc, model.yc) {
+            worst_truth_check = worst_truth_check
+                .max(peopletrack::vision::egomotion::views::wrap_angle(b - true_az).abs());
+        }
         let Some(o) = odom.samples.nearest(f.stamp, 100_000_000) else {
             continue;
         };
@@ -74,8 +128,33 @@ fn session(path: &str, seed: u64) -> Res<(Vec<Sample>, [f64; 3])> {
         let error = res
             .detection
             .map(|d| peopletrack::vision::egomotion::views::wrap_angle(d.azimuth - true_az).abs());
-        out.push(Sample { speed, error });
+        if let Some(dir) = dump_dir
+            && steps % 20 == 0
+        {
+            dump(
+                dir,
+                steps,
+                &f.rgb,
+                &m,
+                true_az,
+                res.detection.map(|d| d.azimuth),
+            )?;
+        }
+        let visibility = p
+            .cameras
+            .iter()
+            .find(|c| c.camera == CAMERA)
+            .map_or(0.0, |c| c.visibility);
+        out.push(Sample {
+            speed,
+            error,
+            visibility,
+        });
     }
+    println!(
+        "{path}: truth check, TF bearing vs head_px bearing: worst {:.2} deg",
+        worst_truth_check.to_degrees()
+    );
     let n = steps.saturating_sub(1).max(1) as f64;
     Ok((
         out,
@@ -84,7 +163,16 @@ fn session(path: &str, seed: u64) -> Res<(Vec<Sample>, [f64; 3])> {
 }
 
 fn main() -> Res<()> {
-    let mut logs: Vec<String> = std::env::args().skip(1).collect();
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let dump_dir = match args.iter().position(|a| a == "--dump") {
+        Some(i) if i + 1 < args.len() => {
+            let d = args.remove(i + 1);
+            args.remove(i);
+            Some(d)
+        }
+        _ => None,
+    };
+    let mut logs = args;
     if logs.is_empty() {
         logs = ["00", "01"]
             .iter()
@@ -93,7 +181,7 @@ fn main() -> Res<()> {
     }
     let mut all = Vec::new();
     for (i, path) in logs.iter().enumerate() {
-        let (samples, [feat, fb, frames]) = session(path, i as u64)?;
+        let (samples, [feat, fb, frames]) = session(path, i as u64, dump_dir.as_deref())?;
         let detected = samples.iter().filter(|s| s.error.is_some()).count();
         let mut errs: Vec<f64> = samples.iter().filter_map(|s| s.error).collect();
         errs.sort_by(f64::total_cmp);
@@ -111,8 +199,16 @@ fn main() -> Res<()> {
             .map(|s| (s.speed, is_lost(s.error, 0.0, th)))
             .collect();
         let total = lost.iter().filter(|l| l.1).count();
+        let visible: Vec<&Sample> = all.iter().filter(|s| s.visibility >= 0.5).collect();
+        let lost_visible = visible.iter().filter(|s| is_lost(s.error, 0.0, th)).count();
         println!(
-            "\nthreshold {:.0} deg: lost {total} of {} frames ({:.1} %)",
+            "\nthreshold {:.0} deg: a uniformly random bearing would be lost in {:.1} % of frames; frames with the target at least half visible: {} ({lost_visible} lost)",
+            th.to_degrees(),
+            100.0 * (1.0 - th / std::f64::consts::PI),
+            visible.len()
+        );
+        println!(
+            "threshold {:.0} deg: lost {total} of {} frames ({:.1} %)",
             th.to_degrees(),
             lost.len(),
             100.0 * total as f64 / lost.len().max(1) as f64

@@ -109,7 +109,7 @@ fn solve(src: &[[f64; 2]], dst: &[[f64; 2]], terms: usize) -> Option<Bilinear> {
     let svd = design.svd(true, true);
     let sv = &svd.singular_values;
     let (max, min) = (sv.max(), sv.min());
-    if !(min > RANK_TOLERANCE * max) {
+    if min.is_nan() || min <= RANK_TOLERANCE * max {
         return None;
     }
     let solve_for = |k: usize| -> Option<[f64; 4]> {

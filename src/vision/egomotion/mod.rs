@@ -272,12 +272,12 @@ impl Method1 {
     }
 }
 
+/// `(current, previous)` positions of the corner pairs of one view.
+pub type ViewPairs = (Vec<[f64; 2]>, Vec<[f64; 2]>);
+
 /// Per view, `(current, previous)` positions of the pairs whose previous position lies in that
 /// view (a pair in the overlap of two views serves both).
-pub fn pairs_per_view(
-    views: &Views,
-    pairs: &[([f64; 2], [f64; 2])],
-) -> Vec<(Vec<[f64; 2]>, Vec<[f64; 2]>)> {
+pub fn pairs_per_view(views: &Views, pairs: &[([f64; 2], [f64; 2])]) -> Vec<ViewPairs> {
     let mut out = vec![(Vec::new(), Vec::new()); views.len()];
     let omni = views.omni();
     for (a, b) in pairs {
@@ -360,7 +360,7 @@ impl DiffField for DiffViews<'_> {
 pub fn is_lost(est_azimuth: Option<f64>, true_azimuth: f64, threshold_rad: f64) -> bool {
     match est_azimuth {
         None => true,
-        Some(a) => !(wrap_angle(a - true_azimuth).abs() <= threshold_rad),
+        Some(a) => a.is_nan() || wrap_angle(a - true_azimuth).abs() > threshold_rad,
     }
 }
 

@@ -121,7 +121,7 @@ impl ParticleFilter {
             q.weight = if v.is_finite() && v > 0.0 { v } else { 0.0 };
             total += q.weight;
         }
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             let w = 1.0 / self.particles.len() as f64;
             self.particles.iter_mut().for_each(|q| q.weight = w);
             return None;
@@ -208,7 +208,7 @@ struct Mixture {
 /// normalised; particles of zero weight are ignored. Empty when no particle weighs anything.
 pub fn em_clusters(particles: &[Particle], k_max: usize, iterations: usize) -> Vec<Cluster> {
     let total: f64 = particles.iter().map(|q| q.weight.max(0.0)).sum();
-    if !(total > 0.0) {
+    if total.is_nan() || total <= 0.0 {
         return Vec::new();
     }
     let pts: Vec<Particle> = particles
@@ -264,7 +264,7 @@ fn em(pts: &[Particle], k: usize, iterations: usize) -> Mixture {
                 .enumerate()
                 .map(|(i, q)| q.weight * resp[i * k + j])
                 .sum();
-            if !(mass > 1e-12) {
+            if mass.is_nan() || mass <= 1e-12 {
                 c.weight = 0.0;
                 continue;
             }
@@ -305,7 +305,7 @@ fn em(pts: &[Particle], k: usize, iterations: usize) -> Mixture {
 fn density(c: &Cluster, q: &Particle) -> f64 {
     let [[a, b], [_, d]] = c.cov;
     let det = a * d - b * b;
-    if !(det > 0.0) {
+    if det.is_nan() || det <= 0.0 {
         return 0.0;
     }
     let (x, y) = (wrap_angle(q.azimuth - c.azimuth), q.elevation - c.elevation);

@@ -187,7 +187,7 @@ impl Views {
         if !(p.hfov_deg > 0.0 && p.hfov_deg < 170.0) {
             return Err(bad("hfov_deg must be in (0, 170)"));
         }
-        if !(p.elevation_deg.abs() < 80.0) {
+        if p.elevation_deg.is_nan() || p.elevation_deg.abs() >= 80.0 {
             return Err(bad("elevation_deg must be in (-80, 80)"));
         }
         let step = std::f64::consts::TAU / p.count as f64;
