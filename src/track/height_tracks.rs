@@ -16,7 +16,10 @@
 //!   every track (and from the other births of the same scan), at h0 with σ h0 as in the
 //!   single-person filter. Cameras never start a track (bearing and elevation do not place a
 //!   head of unknown height).
-//! - **Deletion** of a track that no observation updated for `delete_after_s`.
+//! - **Deletion** of a track that no leg pair updated for `delete_after_s`. Head tops alone do
+//!   not keep a track alive: bearing + elevation do not hold its range (§5: "absolute range
+//!   observations, as provided by the laser, are required"), and a track fed only by a
+//!   camera drifts along the camera's ray while the laser starts a new track for the person.
 //! - A track is reported once `confirm_hits` laser pairs updated it (one stray leg pair does
 //!   not become a person).
 //!
@@ -31,7 +34,7 @@ use crate::assign;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrackerParams {
     pub ekf: EkfParams,
-    /// A track that no observation updated for this long (s) is deleted.
+    /// A track that no leg pair updated for this long (s) is deleted.
     pub delete_after_s: f64,
     /// An unassociated leg pair nearer than this (m) to a track or to another birth of the
     /// same scan starts no track.
@@ -98,6 +101,8 @@ pub struct Track {
     pub born_s: f64,
     /// Time of the last accepted observation (the birth counts).
     pub last_update_s: f64,
+    /// Time of the last accepted leg pair (the birth counts).
+    pub last_laser_s: f64,
     pub laser_hits: u32,
     pub camera_hits: u32,
 }
@@ -142,7 +147,7 @@ impl MultiTracker {
 
     /// One sensor event at `t_s` (never earlier than the last): predict every track, associate
     /// `obs` by GNN inside the gate and update, start tracks from unassociated leg pairs when
-    /// `allow_birth`, and delete tracks not updated for `delete_after_s`.
+    /// `allow_birth`, and delete tracks no leg pair updated for `delete_after_s`.
     pub fn step(&mut self, t_s: f64, obs: &[Observation], allow_birth: bool) -> StepReport {
         for t in &mut self.tracks {
             t.ekf.predict(t_s);
@@ -173,7 +178,10 @@ impl MultiTracker {
             track.ekf = f;
             track.last_update_s = t_s;
             match obs[c] {
-                Observation::Laser { .. } => track.laser_hits += 1,
+                Observation::Laser { .. } => {
+                    track.laser_hits += 1;
+                    track.last_laser_s = t_s;
+                }
                 Observation::Camera { .. } => track.camera_hits += 1,
             }
             taken[c] = true;
@@ -186,7 +194,7 @@ impl MultiTracker {
         }
         let limit = self.params.delete_after_s;
         self.tracks.retain(|t| {
-            let keep = t_s - t.last_update_s <= limit;
+            let keep = t_s - t.last_laser_s <= limit;
             if !keep {
                 report.deleted.push(t.id);
             }
@@ -216,6 +224,7 @@ impl MultiTracker {
                 ekf: HeightEkf::new(e, xy, e.h0_m, e.sigma_h0_m, t_s),
                 born_s: t_s,
                 last_update_s: t_s,
+                last_laser_s: t_s,
                 laser_hits: 1,
                 camera_hits: 0,
             });

@@ -56,6 +56,9 @@ pub struct Run {
     pub first_camera_ns: Option<i64>,
     /// Re-initialisations of the CV variant (`cv_reinit_after_s`).
     pub reinits: usize,
+    /// Longest time from an accepted observation (or the start) to a later rejected event
+    /// with no accepted one between: how long the filter was locked out of its gate (s).
+    pub longest_lockout_s: f64,
 }
 
 impl Run {
@@ -198,6 +201,11 @@ pub fn run(laser: &[LaserObsRow], cam: &[CameraObsRow], p: &Params, m: Method) -
             }
         }
         let accepted = best.is_some();
+        if !accepted {
+            out.longest_lockout_s = out
+                .longest_lockout_s
+                .max(seconds(t.saturating_sub(last_accept_ns)));
+        }
         if let Some((_, trial)) = best {
             *filter = trial;
             last_accept_ns = t;

@@ -150,6 +150,13 @@ fn tracks_are_born_from_free_leg_pairs_confirmed_after_three_and_deleted_after_t
         let r = m.step(t, &obs, true);
         born.extend(r.born.iter().map(|&id| (k, id)));
         deleted.extend(r.deleted.iter().map(|&id| (k, id)));
+        if k >= 6 && m.tracks().iter().any(|t| t.id == 1) {
+            // A's head still seen by the camera 0.1 s after each scan: it updates A's track
+            // but does not keep it alive
+            let r = m.step(t + 0.1, &[head(2.0, 2.0, 1.84, CAM0)], false);
+            assert_eq!(r.assigned, vec![(1, 0)]);
+            deleted.extend(r.deleted.iter().map(|&id| (k, id)));
+        }
         if k == 1 {
             assert!(!m.confirmed(&m.tracks()[0]), "two hits: not yet reported");
         }
@@ -159,8 +166,9 @@ fn tracks_are_born_from_free_leg_pairs_confirmed_after_three_and_deleted_after_t
         }
     }
     assert_eq!(born, vec![(0, 1), (2, 2)]);
-    // A's last update at 1.0 s; deleted at the first step more than 1.0 s later (2.2 s)
-    assert_eq!(deleted, vec![(11, 1)]);
+    // A's last leg pair at 1.0 s; deleted at the first step more than 1.0 s later: the
+    // camera step at 2.1 s (after scan 10)
+    assert_eq!(deleted, vec![(10, 1)]);
     assert_eq!(m.tracks().len(), 1);
     assert_eq!(m.tracks()[0].id, 2);
     // a leg pair 0.55 m from a settled track is outside its gate and inside the birth
@@ -200,7 +208,11 @@ fn two_cameras_alone_learn_position_and_height_where_one_camera_cannot() {
     // a track born from one leg pair 0.4 m off, then only noise-free camera head tops
     let (x, y, h) = (3.0, 2.0, 1.75);
     let run = |cams: &[SensorAt]| {
-        let mut m = MultiTracker::new(params());
+        // no leg pair after the birth: keep the track alive for the whole run
+        let mut m = MultiTracker::new(TrackerParams {
+            delete_after_s: 100.0,
+            ..params()
+        });
         m.step(0.0, &[leg_pair(x + 0.4, y - 0.3)], true);
         for k in 1..=200 {
             let t = 0.05 * f64::from(k);
