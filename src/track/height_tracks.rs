@@ -20,6 +20,11 @@
 //!   not keep a track alive: bearing + elevation do not hold its range (§5: "absolute range
 //!   observations, as provided by the laser, are required"), and a track fed only by a
 //!   camera drifts along the camera's ray while the laser starts a new track for the person.
+//! - **Ambiguous head tops are skipped** (`skip_ambiguous_camera`): a head top inside the
+//!   gates of two or more tracks updates none. Two people of similar height at similar
+//!   bearings from a camera cannot be told apart by bearing + elevation (1.84 vs 1.75 m at
+//!   4 m differ by 0.022 rad, about one σ), and a wrong pick pulls the track along the ray;
+//!   leg pairs are precise enough not to need this.
 //! - A track is reported once `confirm_hits` laser pairs updated it (one stray leg pair does
 //!   not become a person).
 //!
@@ -41,6 +46,8 @@ pub struct TrackerParams {
     pub birth_clearance_m: f64,
     /// Laser updates (the birth included) before a track is reported.
     pub confirm_hits: u32,
+    /// A camera observation inside the gates of two or more tracks updates none.
+    pub skip_ambiguous_camera: bool,
 }
 
 /// One observation of a sensor event.
@@ -164,6 +171,16 @@ impl MultiTracker {
                 })
                 .collect();
             trials.push(row);
+        }
+        if self.params.skip_ambiguous_camera {
+            for (c, o) in obs.iter().enumerate() {
+                let gated = trials.iter().filter(|row| row[c].is_some()).count();
+                if matches!(o, Observation::Camera { .. }) && gated > 1 {
+                    for row in &mut trials {
+                        row[c] = None;
+                    }
+                }
+            }
         }
         let pairs = assign::min_cost_max_pairs(self.tracks.len(), obs.len(), |r, c| {
             trials[r][c].as_ref().map_or(f64::INFINITY, |(d2, _)| *d2)

@@ -91,6 +91,8 @@ pub struct Params {
     pub confirm_hits: u32,
     /// Multi mode: CLEAR MOT match distance on the floor (m).
     pub mot_max_m: f64,
+    /// Multi mode: a head top inside two or more tracks' gates updates none.
+    pub skip_ambiguous_camera: bool,
 }
 
 impl Default for Params {
@@ -137,6 +139,7 @@ impl Default for Params {
             birth_clearance_m: 0.6,
             confirm_hits: 3,
             mot_max_m: 0.75,
+            skip_ambiguous_camera: true,
         }
     }
 }
@@ -178,6 +181,7 @@ impl Params {
             delete_after_s: self.delete_after_s,
             birth_clearance_m: self.birth_clearance_m,
             confirm_hits: self.confirm_hits,
+            skip_ambiguous_camera: self.skip_ambiguous_camera,
         }
     }
 

@@ -23,6 +23,7 @@ fn params() -> TrackerParams {
         delete_after_s: 1.0,
         birth_clearance_m: 0.6,
         confirm_hits: 3,
+        skip_ambiguous_camera: false,
     }
 }
 
@@ -233,4 +234,21 @@ fn two_cameras_alone_learn_position_and_height_where_one_camera_cannot() {
     let (xy1, h1) = run(&[CAM0]);
     let off = (xy1[0] - x).hypot(xy1[1] - y);
     assert!(off > 0.05 || (h1 - h).abs() > 0.02, "{xy1:?} {h1}");
+}
+
+#[test]
+fn a_head_top_in_two_tracks_gates_updates_neither_when_ambiguity_is_skipped() {
+    // two tracks of unknown height on cam_0's axis: any head top on that bearing fits both
+    let run = |skip: bool| {
+        let mut m = MultiTracker::new(TrackerParams {
+            skip_ambiguous_camera: skip,
+            ..params()
+        });
+        m.step(0.0, &[leg_pair(3.0, 3.0), leg_pair(5.0, 3.0)], true);
+        m.step(0.1, &[head(3.0, 3.0, 1.84, CAM0)], false)
+    };
+    let r = run(false);
+    assert_eq!(r.assigned.len(), 1, "{r:?}");
+    let r = run(true);
+    assert!(r.assigned.is_empty() && r.unassigned == vec![0], "{r:?}");
 }
