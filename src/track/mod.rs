@@ -10,6 +10,8 @@
 //! - [`graph_match`]: 2-D tracking by graph matching of rectangles (seed 004 §4).
 //! - [`height_ekf`]: the (x, y, height) EKF of seed 002 §5 — laser range–bearing and camera
 //!   bearing + elevation updates, 3σ gate; a constant-velocity variant.
+//! - [`height_tracks`]: several people for that EKF (our addition): GNN inside the 3σ gate,
+//!   births from free leg pairs, deletion after a timeout; two-camera head triangulation.
 //! - [`cylinders`]: multi-camera 3-D tracking of people as cylinders (seed 004 §5).
 //! - [`reid`]: Bayesian re-identification of people across local tracks (seed 003 §IV):
 //!   NIW kernels, the paper's spatio-temporal transition, assumed-density filtering.
@@ -17,6 +19,7 @@
 pub mod cylinders;
 pub mod graph_match;
 pub mod height_ekf;
+pub mod height_tracks;
 pub mod jpda;
 pub mod kalman;
 pub mod pdaf;

@@ -94,6 +94,24 @@ table_row! {
 }
 
 table_row! {
+    /// Our CV variant beside the paper's filter, per session: `cv_variant`.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct CvRow {
+        pub session: String,
+        pub method: String,
+        pub mean_error_m: Option<f64>,
+        /// Largest speed of the estimate (m/s; 0 for constant position).
+        pub max_speed_mps: f64,
+        /// Longest time locked out of the gate: from an accepted observation to a later
+        /// rejected event with no accepted one between (s).
+        pub longest_lockout_s: f64,
+        pub laser_rejected: i64,
+        pub camera_rejected: i64,
+        pub reinits: i64,
+    }
+}
+
+table_row! {
     /// Paired t-test of two methods' errors at the same truth stamps: `paired_ttest`.
     #[derive(Debug, Clone, PartialEq)]
     pub struct PairRow {
@@ -369,7 +387,45 @@ fn error_tables(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow:
         "Two-sided, level {}; mean_diff = a − b (negative: a closer to the truth). Successive errors are autocorrelated, so the p-values are optimistic.",
         p.level
     )));
+    cv_table(data, p, out)?;
     planes_table(data, out)
+}
+
+fn cv_table(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow::Result<()> {
+    let mut rows = Vec::new();
+    for name in [FUSED, FUSED_CV] {
+        for s in data {
+            let (run, scored) = &s.runs[name];
+            let e: Vec<f64> = scored.iter().map(|x| x.error_m).collect();
+            rows.push(CvRow {
+                session: s.name.clone(),
+                method: name.into(),
+                mean_error_m: mean(&e),
+                max_speed_mps: run
+                    .estimates
+                    .iter()
+                    .map(|x| x.vx.hypot(x.vy))
+                    .fold(0.0, f64::max),
+                longest_lockout_s: run.longest_lockout_s,
+                laser_rejected: run.laser_rejected as i64,
+                camera_rejected: run.camera_rejected as i64,
+                reinits: run.reinits as i64,
+            });
+        }
+    }
+    let mut t = Table::new(
+        "cv_variant",
+        "Our constant-velocity variant beside the paper's constant-position filter (laser + camera): speed, gate lock-out, re-initialisations",
+        CvRow::frame(&rows)?,
+    );
+    for c in ["mean_error_m", "max_speed_mps", "longest_lockout_s"] {
+        t = t.with_precision(c, 3);
+    }
+    out.tables.push(t.with_note(format!(
+        "The CV variant re-initialises its position at the next leg pair (at rest, height and its sigma kept) once no observation was accepted for {} s (cv_reinit_after_s; 0 = never); the paper's filter never does. longest_lockout_s: the longest span from an accepted observation to a rejected event with none accepted between.",
+        p.cv_reinit_after_s
+    )));
+    Ok(())
 }
 
 fn planes_table(data: &[SessionData], out: &mut Products) -> anyhow::Result<()> {

@@ -54,6 +54,11 @@ pub struct Run {
     pub camera_accepted: usize,
     pub camera_rejected: usize,
     pub first_camera_ns: Option<i64>,
+    /// Re-initialisations of the CV variant (`cv_reinit_after_s`).
+    pub reinits: usize,
+    /// Longest time from an accepted observation (or the start) to a later rejected event
+    /// with no accepted one between: how long the filter was locked out of its gate (s).
+    pub longest_lockout_s: f64,
 }
 
 impl Run {
@@ -147,6 +152,9 @@ pub fn run(laser: &[LaserObsRow], cam: &[CameraObsRow], p: &Params, m: Method) -
     let ekf = p.ekf(m.motion);
     let mut out = Run::default();
     let mut f: Option<HeightEkf> = None;
+    let mut last_accept_ns = i64::MIN;
+    let reinit_ns = (m.motion == Motion::ConstantVelocity && p.cv_reinit_after_s > 0.0)
+        .then(|| (p.cv_reinit_after_s * 1e9).round() as i64);
     for (t, ev) in events(laser, cam, m.sensors) {
         let is_cam = matches!(ev, Event::Camera(_));
         if is_cam && out.first_camera_ns.is_none() {
@@ -168,6 +176,7 @@ pub fn run(laser: &[LaserObsRow], cam: &[CameraObsRow], p: &Params, m: Method) -
             };
             if let Some(filter) = &f {
                 out.estimates.push(estimate(filter, t, is_cam));
+                last_accept_ns = t;
             }
             continue;
         };
@@ -192,8 +201,23 @@ pub fn run(laser: &[LaserObsRow], cam: &[CameraObsRow], p: &Params, m: Method) -
             }
         }
         let accepted = best.is_some();
+        if !accepted {
+            out.longest_lockout_s = out
+                .longest_lockout_s
+                .max(seconds(t.saturating_sub(last_accept_ns)));
+        }
         if let Some((_, trial)) = best {
             *filter = trial;
+            last_accept_ns = t;
+        } else if let (Some(after), Event::Laser(g)) = (reinit_ns, &ev)
+            && t.saturating_sub(last_accept_ns) >= after
+        {
+            // our CV variant, locked out of its gate: restart at the leg pair, at rest,
+            // keeping the learned height
+            let (h, sigma_h) = (filter.height(), filter.sigma_height());
+            *filter = HeightEkf::new(ekf, laser_xy(g[0]), h, sigma_h, seconds(t));
+            last_accept_ns = t;
+            out.reinits += 1;
         }
         match (is_cam, accepted) {
             (false, true) => out.laser_accepted += 1,

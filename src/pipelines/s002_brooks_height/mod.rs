@@ -18,6 +18,9 @@ mod camera;
 mod fig4;
 mod figures;
 mod fusion;
+mod multi;
+mod multi_report;
+mod multi_session;
 mod params;
 mod session;
 mod tables;
@@ -29,7 +32,7 @@ use crate::progress::Progress;
 use crate::run::config::Invalid;
 use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
 
-pub use params::Params;
+pub use params::{Mode, Params};
 
 pub struct BrooksHeight;
 
@@ -43,6 +46,9 @@ impl Experiment for BrooksHeight {
     }
 
     fn plan(p: &Params, _: &BTreeMap<String, String>) -> Vec<Stage> {
+        if p.mode == Mode::Multi {
+            return multi_plan(p);
+        }
         let (mask, _) = camera::mask_topics(&p.camera);
         vec![
             Stage {
@@ -81,10 +87,19 @@ impl Experiment for BrooksHeight {
         _: &BTreeMap<String, String>,
         bar: &dyn Progress,
     ) -> anyhow::Result<SessionTables> {
-        session::process(s, p, bar)
+        match p.mode {
+            Mode::Paper => session::process(s, p, bar),
+            Mode::Multi => multi_session::process(s, p, bar),
+        }
     }
 
     fn aggregate(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
+        if p.mode == Mode::Multi {
+            let r = multi_report::compute(ctx, p)?;
+            let mut out = Products::default();
+            multi_report::products(&r, p, &mut out)?;
+            return Ok(out);
+        }
         let data = aggregate::load(ctx, p)?;
         let mut out = Products::default();
         aggregate::tables(&data, p, &mut out)?;
@@ -92,4 +107,29 @@ impl Experiment for BrooksHeight {
         out.summary.extend(figures::summary(&data));
         Ok(out)
     }
+}
+
+/// Multi mode's stages: the laser, each camera, the truth.
+fn multi_plan(p: &Params) -> Vec<Stage> {
+    let mut out = vec![Stage {
+        name: "laser leg pairs (seed 002 §3), every pair".into(),
+        requires: vec![p.scan_topic.clone()],
+        optional: vec!["/tf".into(), "/tf_static".into()],
+    }];
+    for cam in &p.cameras {
+        out.push(Stage {
+            name: format!("camera {cam}: Jabri background, skin, person test (§4)"),
+            requires: vec![format!("/{cam}/camera_info")],
+            optional: vec![
+                format!("/{cam}/image_raw/compressed"),
+                format!("/{cam}/image_raw"),
+            ],
+        });
+    }
+    out.push(Stage {
+        name: "ground truth, every person".into(),
+        requires: vec![crate::groundtruth::PEOPLE_TOPIC.into()],
+        optional: vec![],
+    });
+    out
 }

@@ -8,17 +8,32 @@ use serde::{Deserialize, Serialize};
 
 use crate::run::config::Invalid;
 use crate::track::height_ekf::{EkfParams, Motion};
+use crate::track::height_tracks::TrackerParams;
 use crate::vision::jabri::{ColourPlanes, EdgePlanes, JabriParams};
 use crate::vision::skin::SkinParams;
 
 /// `skin_training` value naming the last log of each session's folder.
 pub const LAST: &str = "last";
 
+/// What the pipeline file runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Mode {
+    /// Seed 002 as published: one person, laser + `camera` (the `office_network` dataset).
+    Paper,
+    /// Our addition: several people, laser + every camera of `cameras`, one EKF per person
+    /// ([`crate::track::height_tracks`]); scored with CLEAR MOT and per-person heights.
+    Multi,
+}
+
 /// `[params]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Params {
+    pub mode: Mode,
     pub camera: String,
+    /// Multi mode: the cameras, in order (the first alone is the one-camera run).
+    pub cameras: Vec<String>,
     pub scan_topic: String,
     /// Skin-training logs (globs), or `["last"]`: the last log (by name) in each session's
     /// folder — the dataset's skin-training session, which is then not evaluated. The histogram
@@ -48,6 +63,10 @@ pub struct Params {
     /// Filter noise (see [`crate::track::height_ekf::EkfParams`]).
     pub q_pos: f64,
     pub q_pos_cv: f64,
+    /// Our CV variant only: when no observation was accepted for this long (s), the next
+    /// leg pair re-initialises the position there (velocity 0, height and its σ kept);
+    /// 0 = never. The paper's constant-position filter never re-initialises.
+    pub cv_reinit_after_s: f64,
     pub q_height: f64,
     pub sigma_range_m: f64,
     pub sigma_bearing_rad: f64,
@@ -64,12 +83,24 @@ pub struct Params {
     pub level: f64,
     /// Room outline for the top view `[x0, y0, x1, y1]` (m, map frame; drawing only).
     pub room_m: [f64; 4],
+    /// Multi mode: a track not updated for this long (s) is deleted.
+    pub delete_after_s: f64,
+    /// Multi mode: a free leg pair nearer than this (m) to a track starts no track.
+    pub birth_clearance_m: f64,
+    /// Multi mode: laser updates before a track is reported.
+    pub confirm_hits: u32,
+    /// Multi mode: CLEAR MOT match distance on the floor (m).
+    pub mot_max_m: f64,
+    /// Multi mode: a head top inside two or more tracks' gates updates none.
+    pub skip_ambiguous_camera: bool,
 }
 
 impl Default for Params {
     fn default() -> Self {
         Params {
+            mode: Mode::Paper,
             camera: "cam_0".into(),
+            cameras: Vec::new(),
             scan_topic: "/scan".into(),
             skin_training: vec![LAST.into()],
             skin_training_every: 5,
@@ -90,6 +121,7 @@ impl Default for Params {
             warmup_frames: 10,
             q_pos: 0.5,
             q_pos_cv: 2.0,
+            cv_reinit_after_s: 1.0,
             q_height: 1e-4,
             sigma_range_m: 0.1,
             sigma_bearing_rad: 0.02,
@@ -103,6 +135,11 @@ impl Default for Params {
             lag_min_speed: 0.3,
             level: 0.95,
             room_m: [0.0, 0.0, 8.0, 6.0],
+            delete_after_s: 2.0,
+            birth_clearance_m: 0.6,
+            confirm_hits: 3,
+            mot_max_m: 0.75,
+            skip_ambiguous_camera: true,
         }
     }
 }
@@ -127,6 +164,25 @@ impl Params {
         self.training_logs(session)
             .iter()
             .any(|t| same_file(t, session))
+    }
+
+    /// These parameters with `camera` set to `name` (multi mode runs the camera stage once
+    /// per camera).
+    pub fn for_camera(&self, name: &str) -> Params {
+        Params {
+            camera: name.into(),
+            ..self.clone()
+        }
+    }
+
+    pub fn tracker(&self) -> TrackerParams {
+        TrackerParams {
+            ekf: self.ekf(Motion::ConstantPosition),
+            delete_after_s: self.delete_after_s,
+            birth_clearance_m: self.birth_clearance_m,
+            confirm_hits: self.confirm_hits,
+            skip_ambiguous_camera: self.skip_ambiguous_camera,
+        }
     }
 
     pub fn jabri(&self) -> JabriParams {
@@ -187,6 +243,9 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
         ("sigma_h0_m", p.sigma_h0_m),
         ("sigma_pos0_m", p.sigma_pos0_m),
         ("gate_sigma", p.gate_sigma),
+        ("delete_after_s", p.delete_after_s),
+        ("birth_clearance_m", p.birth_clearance_m),
+        ("mot_max_m", p.mot_max_m),
         ("k_sigma", f64::from(p.k_sigma)),
         ("sigma_floor", f64::from(p.sigma_floor)),
         ("sigma_init", f64::from(p.sigma_init)),
@@ -196,6 +255,18 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
     }
     if !(p.alpha > 0.0 && p.alpha <= 1.0) {
         out.push(("alpha".into(), format!("{} is not in (0, 1]", p.alpha)));
+    }
+    if !(p.cv_reinit_after_s.is_finite() && p.cv_reinit_after_s >= 0.0) {
+        out.push((
+            "cv_reinit_after_s".into(),
+            format!("{} must be >= 0 (0 = never)", p.cv_reinit_after_s),
+        ));
+    }
+    if p.mode == Mode::Multi && p.cameras.is_empty() {
+        out.push((
+            "cameras".into(),
+            "mode = \"multi\" needs at least one camera".into(),
+        ));
     }
     if !(p.level > 0.0 && p.level < 1.0) {
         out.push(("level".into(), format!("{} is not in (0, 1)", p.level)));

@@ -26,7 +26,7 @@ use crate::report::rows::Rows;
 use crate::run::{Session, SessionTables};
 
 /// Leg pairs of every scan as range–bearing observations.
-fn laser_observations(log: &SessionLog, p: &Params) -> anyhow::Result<Vec<LaserObsRow>> {
+pub(super) fn laser_observations(log: &SessionLog, p: &Params) -> anyhow::Result<Vec<LaserObsRow>> {
     let options = LaserOptions {
         fixed_frame: Some("map".into()),
         ..LaserOptions::default()

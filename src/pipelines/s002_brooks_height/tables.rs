@@ -105,3 +105,23 @@ pub fn read<R: Rows>(tables: &SessionTables, name: &str, session: &str) -> anyho
         .with_context(|| format!("{session}: cached result lacks the {name} table"))?;
     R::read(df).with_context(|| format!("{session}: reading the cached {name} table"))
 }
+
+/// Multi mode: the ground truth of every person (map frame): `people_truth`.
+pub const PEOPLE_TRUTH: &str = "people_truth";
+
+/// Multi mode: the table of camera `name`'s head-top observations (rows of [`CameraObsRow`]).
+pub fn camera_table(name: &str) -> String {
+    format!("{CAMERA}_{name}")
+}
+
+table_row! {
+    /// Multi mode: one person at one ground-truth stamp: `people_truth`.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct PersonRow {
+        pub stamp_ns: i64,
+        pub id: i64,
+        pub x: f64,
+        pub y: f64,
+        pub height_m: f64,
+    }
+}
