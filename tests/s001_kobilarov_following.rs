@@ -142,10 +142,22 @@ fn the_closed_loop_is_reproduced_by_its_replay_and_the_robot_keeps_the_person() 
     assert!(r > 1.0 && r < 3.8, "r_avg {r}");
     assert!(v > 0.3, "v_avg {v}");
     assert_eq!(rows.iter().filter(|r| r["source"] == "paper").count(), 14);
-    for name in ["methods.csv", "ttests.csv", "rst_events.csv", "rst_summary.csv", "method1_loss.csv", "real.csv"] {
+    for name in [
+        "methods.csv",
+        "ttests.csv",
+        "rst_events.csv",
+        "rst_summary.csv",
+        "method1_loss.csv",
+        "real.csv",
+    ] {
         assert!(t.join(name).exists(), "{name} missing");
     }
-    for fig in ["fig4_trajectory", "fig5_covariance", "fig7_following", "closed_loop_top_view"] {
+    for fig in [
+        "fig4_trajectory",
+        "fig5_covariance",
+        "fig7_following",
+        "closed_loop_top_view",
+    ] {
         let p = out.join(format!("s001_kobilarov_following/figures/{fig}.png"));
         assert!(p.exists(), "{fig} missing");
     }
@@ -162,7 +174,10 @@ fn tables_do_not_depend_on_the_thread_count() {
     let (ta, tb) = (tables(&a), tables(&b));
     assert!(ta.len() >= 8, "{:?}", ta.keys());
     let differ: Vec<&String> = ta.keys().filter(|k| ta.get(*k) != tb.get(*k)).collect();
-    assert!(differ.is_empty(), "tables differ between -j 1 and -j 3: {differ:?}");
+    assert!(
+        differ.is_empty(),
+        "tables differ between -j 1 and -j 3: {differ:?}"
+    );
 }
 
 /// The closed loop writes the same bytes whatever rayon's thread count.
@@ -197,7 +212,8 @@ fn the_closed_loop_log_is_byte_identical_on_one_and_two_threads() {
 /// The real person-following log (laser only) runs when `../shared/real` is present.
 #[test]
 fn the_real_person_following_log_runs_laser_only() {
-    let real = root().join("../shared/real/laser/person_following_outdoor_1/person_following_outdoor_1.mcap");
+    let real = root()
+        .join("../shared/real/laser/person_following_outdoor_1/person_following_outdoor_1.mcap");
     if !real.exists() {
         eprintln!("SKIPPED: {} is absent", real.display());
         return;

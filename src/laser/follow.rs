@@ -153,7 +153,12 @@ impl Default for FollowSpec {
 
 impl FollowSpec {
     /// The follower's parameters with this motion model, association and colour setting.
-    pub fn params(&self, model: ModelKind, association: AssociationKind, colour: bool) -> FollowParams {
+    pub fn params(
+        &self,
+        model: ModelKind,
+        association: AssociationKind,
+        colour: bool,
+    ) -> FollowParams {
         FollowParams {
             filter: FilterParams {
                 model,
@@ -212,16 +217,26 @@ impl FollowSpec {
                 out.push((k.to_string(), format!("{v} must be finite and > 0")));
             }
         }
-        for (k, v) in [("p_d", self.p_d), ("imm_switch", self.imm_switch), ("template_update", self.template_update)] {
+        for (k, v) in [
+            ("p_d", self.p_d),
+            ("imm_switch", self.imm_switch),
+            ("template_update", self.template_update),
+        ] {
             if !(0.0..=1.0).contains(&v) {
                 out.push((k.to_string(), format!("{v} is not in [0, 1]")));
             }
         }
         if !(self.clutter_density.is_finite() && self.clutter_density >= 0.0) {
-            out.push(("clutter_density".into(), format!("{} must be finite and >= 0", self.clutter_density)));
+            out.push((
+                "clutter_density".into(),
+                format!("{} must be finite and >= 0", self.clutter_density),
+            ));
         }
         if !(self.corr_min.is_finite() && self.corr_min <= 0.0) {
-            out.push(("corr_min".into(), format!("{} must be finite and <= 0", self.corr_min)));
+            out.push((
+                "corr_min".into(),
+                format!("{} must be finite and <= 0", self.corr_min),
+            ));
         }
         out
     }
@@ -437,7 +452,9 @@ impl FollowTracker {
             if w > 0.0
                 && let (Some(t), Some(Some(h))) = (self.template.as_mut(), hists.get(j))
             {
-                t.iter_mut().zip(h).for_each(|(t, h)| *t = (1.0 - w) * *t + w * h);
+                t.iter_mut()
+                    .zip(h)
+                    .for_each(|(t, h)| *t = (1.0 - w) * *t + w * h);
             }
         }
         if filter.needs_reset() {

@@ -205,9 +205,11 @@ pub fn corr_normalised(a: &[f64], b: &[f64]) -> f64 {
 }
 
 fn sums(a: &[f64], b: &[f64]) -> (f64, f64, f64) {
-    a.iter().zip(b).fold((0.0, 0.0, 0.0), |(ab, aa, bb), (x, y)| {
-        (ab + x * y, aa + x * x, bb + y * y)
-    })
+    a.iter()
+        .zip(b)
+        .fold((0.0, 0.0, 0.0), |(ab, aa, bb), (x, y)| {
+            (ab + x * y, aa + x * x, bb + y * y)
+        })
 }
 
 /// lr = max(corr, 0) · (1 − corr_min) (the paper's γ_T / γ_C).

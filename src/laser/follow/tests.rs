@@ -55,7 +55,10 @@ fn two_legs_are_one_blob_and_a_wall_is_none() {
     let bl = blobs(&pts, &params(ModelKind::Cv));
     assert_eq!(bl.len(), 1, "{bl:?}");
     let b = bl[0];
-    assert!((b.centre[1] - 0.5).abs() < 0.05 && (b.centre[0] - 2.95).abs() < 0.05, "{b:?}");
+    assert!(
+        (b.centre[1] - 0.5).abs() < 0.05 && (b.centre[0] - 2.95).abs() < 0.05,
+        "{b:?}"
+    );
     assert!(b.width > 0.2 && b.width < 0.4);
 }
 

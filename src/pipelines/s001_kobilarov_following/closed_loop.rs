@@ -12,7 +12,12 @@ use crate::log::{SessionLog, TfBuffer};
 use crate::time::Nanos;
 
 /// Every logged state, in log order; `t0` is the session's first scan stamp.
-pub fn rows(tf: &TfBuffer, log: &SessionLog, topic: &str, t0: Nanos) -> anyhow::Result<Vec<LoopRow>> {
+pub fn rows(
+    tf: &TfBuffer,
+    log: &SessionLog,
+    topic: &str,
+    t0: Nanos,
+) -> anyhow::Result<Vec<LoopRow>> {
     let mut out = Vec::new();
     if log.summary().channel(topic).is_none() {
         return Ok(out);
@@ -28,7 +33,10 @@ pub fn rows(tf: &TfBuffer, log: &SessionLog, topic: &str, t0: Nanos) -> anyhow::
         })?;
         let at = Nanos(st.stamp_ns);
         let map_from_odom = tf.lookup("map", &st.frame_id, at).ok();
-        let pos = st.position.zip(map_from_odom).map(|(q, m)| m * Point3::new(q[0], q[1], 0.0));
+        let pos = st
+            .position
+            .zip(map_from_odom)
+            .map(|(q, m)| m * Point3::new(q[0], q[1], 0.0));
         let vel = st
             .velocity
             .zip(map_from_odom)

@@ -13,9 +13,8 @@
 //! `replay_check` compares the replay of the paper's configuration with what the robot itself
 //! logged in the closed loop (they differ only by the pose the scans were placed with).
 
-use super::aggregate::SessionData;
 use super::params::{self, Params};
-use super::tables::TrackRow;
+use super::tables::{SessionData, TrackRow};
 use crate::eval::stats;
 use crate::report::rows::Rows;
 use crate::report::table::Table;
@@ -95,9 +94,15 @@ fn method_row(d: &SessionData, m: &str, p: &Params) -> MethodRow {
         method: m.into(),
         scans: rows.len() as i64,
         tracked: rows.iter().filter(|r| r.x.is_some()).count() as f64 / n,
-        on_target: rows.iter().filter(|r| r.target_err_m.is_some_and(|e| e <= p.lock_m)).count() as f64 / n,
+        on_target: rows
+            .iter()
+            .filter(|r| r.target_err_m.is_some_and(|e| e <= p.lock_m))
+            .count() as f64
+            / n,
         mean_err_m: (!errs.is_empty()).then(|| errs.iter().sum::<f64>() / errs.len() as f64),
-        p95_err_m: errs.get(((errs.len() as f64 * 0.95) as usize).min(errs.len().saturating_sub(1))).copied(),
+        p95_err_m: errs
+            .get(((errs.len() as f64 * 0.95) as usize).min(errs.len().saturating_sub(1)))
+            .copied(),
         wrong_lock: rows.iter().filter(|r| wrong(r, p)).count() as f64 / n,
         wrong_lock_events: events,
         rst: rows.iter().filter(|r| r.reset).count() as i64,
@@ -124,7 +129,12 @@ pub fn occlusion_ends(d: &SessionData, p: &Params) -> Vec<(f64, f64)> {
 }
 
 /// Per event of a run: `f` over the method's rows in the window after the occlusion.
-fn per_event(d: &SessionData, m: &str, p: &Params, f: &dyn Fn(&[&TrackRow]) -> Option<f64>) -> Vec<Option<f64>> {
+fn per_event(
+    d: &SessionData,
+    m: &str,
+    p: &Params,
+    f: &dyn Fn(&[&TrackRow]) -> Option<f64>,
+) -> Vec<Option<f64>> {
     occlusion_ends(d, p)
         .iter()
         .map(|&(_, end)| {
@@ -143,13 +153,19 @@ fn mean_err(w: &[&TrackRow]) -> Option<f64> {
 }
 
 /// A paired t-test of two value lists, pairs with a missing side left out.
-fn paired(q: &str, unit: &str, measure: &str, a: (&str, &[Option<f64>]), b: (&str, &[Option<f64>]), level: f64) -> TestRow {
-    let (xa, xb): (Vec<f64>, Vec<f64>) = a
-        .1
-        .iter()
-        .zip(b.1)
-        .filter_map(|(x, y)| Some((x.filter(|v| v.is_finite())?, y.filter(|v| v.is_finite())?)))
-        .unzip();
+fn paired(
+    q: &str,
+    unit: &str,
+    measure: &str,
+    a: (&str, &[Option<f64>]),
+    b: (&str, &[Option<f64>]),
+    level: f64,
+) -> TestRow {
+    let (xa, xb): (Vec<f64>, Vec<f64>) =
+        a.1.iter()
+            .zip(b.1)
+            .filter_map(|(x, y)| Some((x.filter(|v| v.is_finite())?, y.filter(|v| v.is_finite())?)))
+            .unzip();
     let test = stats::paired_t(&xa, &xb, level).ok();
     let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
     TestRow {
@@ -175,7 +191,9 @@ pub fn ttests(data: &[&SessionData], p: &Params) -> Vec<TestRow> {
     let events = |m: &str, f: &dyn Fn(&[&TrackRow]) -> Option<f64>| -> Vec<Option<f64>> {
         data.iter().flat_map(|d| per_event(d, m, p, f)).collect()
     };
-    let locked = |w: &[&TrackRow]| (!w.is_empty()).then(|| f64::from(u8::from(w.last().is_some_and(|r| wrong(r, p)))));
+    let locked = |w: &[&TrackRow]| {
+        (!w.is_empty()).then(|| f64::from(u8::from(w.last().is_some_and(|r| wrong(r, p)))))
+    };
     let lvl = p.level;
     let mut out = Vec::new();
     let models = [params::CV, params::PAPER, params::IMM];
@@ -183,7 +201,14 @@ pub fn ttests(data: &[&SessionData], p: &Params) -> Vec<TestRow> {
         for b in &models[i + 1..] {
             if has(a) && has(b) {
                 let q = "CV vs CT vs IMM: error after an occlusion";
-                out.push(paired(q, "event", "mean error (m)", (a, &events(a, &mean_err)), (b, &events(b, &mean_err)), lvl));
+                out.push(paired(
+                    q,
+                    "event",
+                    "mean error (m)",
+                    (a, &events(a, &mean_err)),
+                    (b, &events(b, &mean_err)),
+                    lvl,
+                ));
                 let f = |r: &MethodRow| {
                     let v: Vec<f64> = data
                         .iter()
@@ -193,7 +218,14 @@ pub fn ttests(data: &[&SessionData], p: &Params) -> Vec<TestRow> {
                         .collect();
                     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
                 };
-                out.push(paired(q, "run", "mean error after occlusions (m)", (a, &per_run(a, &f)), (b, &per_run(b, &f)), lvl));
+                out.push(paired(
+                    q,
+                    "run",
+                    "mean error after occlusions (m)",
+                    (a, &per_run(a, &f)),
+                    (b, &per_run(b, &f)),
+                    lvl,
+                ));
             }
         }
     }
@@ -201,15 +233,43 @@ pub fn ttests(data: &[&SessionData], p: &Params) -> Vec<TestRow> {
     if has(c) && has(nc) {
         let q = "colour likelihood: wrong-target locks";
         let f = |r: &MethodRow| Some(r.wrong_lock);
-        out.push(paired(q, "run", "share of scans locked on another person", (c, &per_run(c, &f)), (nc, &per_run(nc, &f)), lvl));
-        out.push(paired(q, "event", "locked on another person at the window's end (0/1)", (c, &events(c, &locked)), (nc, &events(nc, &locked)), lvl));
+        out.push(paired(
+            q,
+            "run",
+            "share of scans locked on another person",
+            (c, &per_run(c, &f)),
+            (nc, &per_run(nc, &f)),
+            lvl,
+        ));
+        out.push(paired(
+            q,
+            "event",
+            "locked on another person at the window's end (0/1)",
+            (c, &events(c, &locked)),
+            (nc, &events(nc, &locked)),
+            lvl,
+        ));
     }
     let nn = params::NN;
     if has(nc) && has(nn) {
         let q = "PDAF vs nearest neighbour";
         let f = |r: &MethodRow| r.mean_err_m;
-        out.push(paired(q, "run", "mean error (m)", (nc, &per_run(nc, &f)), (nn, &per_run(nn, &f)), lvl));
-        out.push(paired(q, "event", "mean error after an occlusion (m)", (nc, &events(nc, &mean_err)), (nn, &events(nn, &mean_err)), lvl));
+        out.push(paired(
+            q,
+            "run",
+            "mean error (m)",
+            (nc, &per_run(nc, &f)),
+            (nn, &per_run(nn, &f)),
+            lvl,
+        ));
+        out.push(paired(
+            q,
+            "event",
+            "mean error after an occlusion (m)",
+            (nc, &events(nc, &mean_err)),
+            (nn, &events(nn, &mean_err)),
+            lvl,
+        ));
     }
     out
 }
@@ -220,7 +280,9 @@ fn replay_rows(data: &[&SessionData]) -> Vec<ReplayRow> {
             let rows: Vec<&TrackRow> = d.method(params::PAPER).collect();
             let mut dist = Vec::new();
             for l in d.closed_loop.iter().filter(|l| l.x.is_some()) {
-                let near = rows.iter().min_by(|a, b| (a.t_s - l.t_s).abs().total_cmp(&(b.t_s - l.t_s).abs()));
+                let near = rows
+                    .iter()
+                    .min_by(|a, b| (a.t_s - l.t_s).abs().total_cmp(&(b.t_s - l.t_s).abs()));
                 if let Some(r) = near.filter(|r| (r.t_s - l.t_s).abs() < 0.02)
                     && let (Some(x), Some(y), Some(lx), Some(ly)) = (r.x, r.y, l.x, l.y)
                 {
@@ -230,7 +292,8 @@ fn replay_rows(data: &[&SessionData]) -> Vec<ReplayRow> {
             ReplayRow {
                 run: d.name.clone(),
                 scans_both: dist.len() as i64,
-                mean_distance_m: (!dist.is_empty()).then(|| dist.iter().sum::<f64>() / dist.len() as f64),
+                mean_distance_m: (!dist.is_empty())
+                    .then(|| dist.iter().sum::<f64>() / dist.len() as f64),
                 median_distance_m: {
                     let mut d = dist.clone();
                     d.sort_by(f64::total_cmp);
@@ -254,7 +317,13 @@ pub fn tables(data: &[&SessionData], p: &Params) -> anyhow::Result<Vec<Table>> {
         "Replayed trackers on the closed-loop logs: tracking, error to the person, wrong-target locks, rst",
         MethodRow::frame(&rows)?,
     );
-    for c in ["tracked", "on_target", "mean_err_m", "p95_err_m", "wrong_lock"] {
+    for c in [
+        "tracked",
+        "on_target",
+        "mean_err_m",
+        "p95_err_m",
+        "wrong_lock",
+    ] {
         tm = tm.with_precision(c, 3);
     }
     let tm = tm.with_note(format!(
@@ -278,6 +347,8 @@ pub fn tables(data: &[&SessionData], p: &Params) -> anyhow::Result<Vec<Table>> {
         "The replayed paper configuration vs the closed loop's own logged estimates",
         ReplayRow::frame(&replay_rows(data))?,
     );
-    tr = tr.with_precision("mean_distance_m", 3).with_precision("median_distance_m", 3);
+    tr = tr
+        .with_precision("mean_distance_m", 3)
+        .with_precision("median_distance_m", 3);
     Ok(vec![tm, tt, tr])
 }

@@ -10,10 +10,9 @@
 //!   1 m/s);
 //! - `closed_loop_top_view`: the whole run, robot and person, with the `rst` positions.
 
-use super::aggregate::SessionData;
 use super::method1::{self, LossRow};
 use super::params::Params;
-use super::tables::{Method1Row, TruthRow};
+use super::tables::{Method1Row, SessionData, TruthRow};
 use crate::report::figure::{
     Bar, BarPlot, Circle, Event, Figure, FigureKind, LinePlot, Mark, Panels, Series, TopView,
 };
@@ -57,21 +56,39 @@ fn fig4(d: &SessionData) -> Figure {
         Series::line("robot", robot, 0),
         Series::line("person (truth)", person, 3).with_mark(Mark::Dashed),
     ];
-    let est: Vec<_> = d.closed_loop.iter().filter(|l| l.x.is_some()).step_by(5).collect();
+    let est: Vec<_> = d
+        .closed_loop
+        .iter()
+        .filter(|l| l.x.is_some())
+        .step_by(5)
+        .collect();
     for (k, l) in est.iter().enumerate() {
-        let (Some(x), Some(y)) = (l.x, l.y) else { continue };
+        let (Some(x), Some(y)) = (l.x, l.y) else {
+            continue;
+        };
         if let Some(r) = robot_at(&d.truth, l.t_s) {
             let name = if k == 0 { "robot to estimate" } else { "" };
             tr.push(Series::line(name, vec![(r.robot_x, r.robot_y), (x, y)], 2));
         }
         if let (Some(vx), Some(vy)) = (l.vx, l.vy) {
-            let name = if k == 0 { "estimated velocity (0.5 s)" } else { "" };
-            tr.push(Series::line(name, vec![(x, y), (x + 0.5 * vx, y + 0.5 * vy)], 5));
+            let name = if k == 0 {
+                "estimated velocity (0.5 s)"
+            } else {
+                ""
+            };
+            tr.push(Series::line(
+                name,
+                vec![(x, y), (x + 0.5 * vx, y + 0.5 * vy)],
+                5,
+            ));
         }
     }
     Figure::new(
         "fig4_trajectory",
-        format!("Fig. 4: robot path joined to every 5th estimate, {}", d.name),
+        format!(
+            "Fig. 4: robot path joined to every 5th estimate, {}",
+            d.name
+        ),
         FigureKind::TopView(TopView {
             trajectories: tr,
             ..TopView::default()
@@ -102,7 +119,11 @@ fn fig5(d: &SessionData) -> Figure {
         .collect();
     let mut events: Vec<Event> = starts(&d.truth, |r| r.occluded)
         .into_iter()
-        .map(|x| Event { x, label: "x".into(), color: 2 })
+        .map(|x| Event {
+            x,
+            label: "x".into(),
+            color: 2,
+        })
         .collect();
     events.extend(starts(&d.truth, |r| r.ground).into_iter().map(|x| Event {
         x,
@@ -165,8 +186,16 @@ fn fig7(d: &SessionData, p: &Params) -> Figure {
         FigureKind::Panels(Panels {
             columns: 1,
             panels: vec![
-                panel("following error E_follow", "E_follow (m)", Series::line("E_follow", err, 4)),
-                panel("bearing to the person", "bearing (deg)", Series::line("bearing", bearing, 5)),
+                panel(
+                    "following error E_follow",
+                    "E_follow (m)",
+                    Series::line("E_follow", err, 4),
+                ),
+                panel(
+                    "bearing to the person",
+                    "bearing (deg)",
+                    Series::line("bearing", bearing, 5),
+                ),
             ],
         }),
     )
@@ -213,7 +242,10 @@ fn top_view(d: &SessionData) -> Figure {
         .collect();
     Figure::new(
         "closed_loop_top_view",
-        format!("Closed loop, {}: robot, person, tracker estimates; circles: rst", d.name),
+        format!(
+            "Closed loop, {}: robot, person, tracker estimates; circles: rst",
+            d.name
+        ),
         FigureKind::TopView(TopView {
             trajectories: vec![
                 Series::line("robot (truth)", robot, 0),

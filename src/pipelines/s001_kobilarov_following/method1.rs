@@ -35,7 +35,10 @@ impl State {
         camera_frame: String,
         log: &std::path::Path,
     ) -> anyhow::Result<State> {
-        let name = log.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+        let name = log
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default();
         let seed = rng::hash(0x5eed_0001, &[xxhash_rust::xxh3::xxh3_64(name.as_bytes())]);
         Ok(State {
             m: Method1::new(model, &p.method1, seed)
@@ -56,7 +59,10 @@ impl State {
         (idx, stamp, t): (i64, Nanos, f64),
         img: &RgbImage,
     ) -> anyhow::Result<Option<Method1Row>> {
-        let out = self.m.step(img).map_err(|e| anyhow::anyhow!("method 1 at frame {idx}: {e}"))?;
+        let out = self
+            .m
+            .step(img)
+            .map_err(|e| anyhow::anyhow!("method 1 at frame {idx}: {e}"))?;
         Ok(self.row(tf, gt, tolerance_ns, (idx, stamp, t), &out))
     }
 
@@ -95,7 +101,9 @@ impl State {
 /// The robot's true speed at `at` from `map <- base_link` 0.1 s apart.
 fn robot_speed(tf: &TfBuffer, at: Nanos) -> Option<f64> {
     let dt = 100_000_000u64;
-    let a = tf.lookup("map", "base_link", Nanos(at.0.saturating_sub(dt))).ok()?;
+    let a = tf
+        .lookup("map", "base_link", Nanos(at.0.saturating_sub(dt)))
+        .ok()?;
     let b = tf.lookup("map", "base_link", at).ok()?;
     Some((b.translation.vector - a.translation.vector).xy().norm() / (dt as f64 * 1e-9))
 }

@@ -47,7 +47,11 @@ impl Experiment for KobilarovFollowing {
 
     fn plan(p: &Params, _: &BTreeMap<String, String>) -> Vec<Stage> {
         let mut laser = vec![p.scan_topic.clone(), "/tf".into(), "/tf_static".into()];
-        laser.extend(p.real.iter().flat_map(|r| [r.scan_topic.clone(), r.gt_topic.clone()]));
+        laser.extend(
+            p.real
+                .iter()
+                .flat_map(|r| [r.scan_topic.clone(), r.gt_topic.clone()]),
+        );
         vec![
             Stage {
                 name: "laser blobs + replayed trackers (seed 001 §V)".into(),

@@ -186,7 +186,10 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
         out.push(("method1_every".into(), "0 must be >= 1".into()));
     }
     if p.methods.is_empty() {
-        out.push(("methods".into(), "is empty: name at least one method".into()));
+        out.push((
+            "methods".into(),
+            "is empty: name at least one method".into(),
+        ));
     }
     for m in &p.methods {
         if method(m).is_none() {

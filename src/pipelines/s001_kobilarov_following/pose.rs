@@ -32,7 +32,12 @@ impl Tilt {
                 continue;
             }
             let (roll, pitch, _) = UnitQuaternion::from_quaternion(q).euler_angles();
-            let stamp = m.header.stamp.nanos().filter(|s| s.0 > 0).unwrap_or(log_time);
+            let stamp = m
+                .header
+                .stamp
+                .nanos()
+                .filter(|s| s.0 > 0)
+                .unwrap_or(log_time);
             pairs.push((stamp.0, (roll, pitch)));
         }
         pairs.sort_by_key(|p| p.0);

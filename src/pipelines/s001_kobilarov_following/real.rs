@@ -21,7 +21,9 @@ use crate::run::{Session, SessionTables};
 pub fn methods(p: &Params) -> Vec<(String, Method)> {
     let mut out: Vec<(String, Method)> = Vec::new();
     for name in &p.methods {
-        let Some(m) = params::method(name) else { continue };
+        let Some(m) = params::method(name) else {
+            continue;
+        };
         let m = match m {
             Method::Follower {
                 model, association, ..
@@ -136,7 +138,10 @@ crate::table_row! {
 }
 
 /// The real sequences' results; a listed sequence without a session says SKIPPED.
-pub fn table(data: &[super::aggregate::SessionData], p: &Params) -> anyhow::Result<crate::report::table::Table> {
+pub fn table(
+    data: &[tables::SessionData],
+    p: &Params,
+) -> anyhow::Result<crate::report::table::Table> {
     let mut rows = Vec::new();
     for seq in &p.real {
         let Some(d) = data.iter().find(|d| d.name == seq.name && d.is_real()) else {
@@ -166,7 +171,8 @@ pub fn table(data: &[super::aggregate::SessionData], p: &Params) -> anyhow::Resu
                 status: "ok".into(),
                 annotated_scans: r.len() as i64,
                 on_target: Some(on.len() as f64 / n),
-                mean_err_on_target_m: (!on.is_empty()).then(|| on.iter().sum::<f64>() / on.len() as f64),
+                mean_err_on_target_m: (!on.is_empty())
+                    .then(|| on.iter().sum::<f64>() / on.len() as f64),
                 with_estimate: Some(r.iter().filter(|x| x.x.is_some()).count() as f64 / n),
                 rst_on_annotated: r.iter().filter(|x| x.reset).count() as i64,
             });

@@ -83,7 +83,7 @@ impl LaserSelect {
             estimate: None,
             reset: false,
             initialised: false,
-            blobs: people.len() as i64 as usize,
+            blobs: people.len(),
             gated: 0,
             beta0: None,
             chosen: None,

@@ -16,9 +16,9 @@ use image::RgbImage;
 use nalgebra::{Isometry3, Point3};
 
 use super::params::{self, Params};
+use super::pose::{self, Tilt};
 use super::replay::{self, Runner};
 use super::tables::{self, Method1Row, TrackRow, TruthRow};
-use super::pose::{self, Tilt};
 use super::{closed_loop, method1, real, scene};
 use crate::frames::camera as camera_frames;
 use crate::frames::laser::{self as laser_frames, LaserFrame, LaserOptions};
@@ -77,7 +77,14 @@ impl Ctx<'_> {
     /// `fixed <- frame` as the robot knew it (see [`pose`]).
     fn fixed_from(&self, frame: &str, at: Nanos) -> Option<Isometry3<f64>> {
         let p = self.p;
-        pose::fixed_from(&self.tf, &self.tilt, &p.fixed_frame, &p.base_frame, frame, at)
+        pose::fixed_from(
+            &self.tf,
+            &self.tilt,
+            &p.fixed_frame,
+            &p.base_frame,
+            frame,
+            at,
+        )
     }
 }
 
@@ -188,7 +195,12 @@ fn replay_all(ctx: &mut Ctx<'_>, bar: &dyn Progress) -> anyhow::Result<Replayed>
         index: 0,
     };
     let mut method1 = match ctx.model.as_ref() {
-        Some(m) => Some(method1::State::new(m, p, ctx.camera_frame.clone(), ctx.log.path())?),
+        Some(m) => Some(method1::State::new(
+            m,
+            p,
+            ctx.camera_frame.clone(),
+            ctx.log.path(),
+        )?),
         None => None,
     };
     let mut runners: Vec<(String, Runner)> = Vec::new();
@@ -224,7 +236,15 @@ fn replay_all(ctx: &mut Ctx<'_>, bar: &dyn Progress) -> anyhow::Result<Replayed>
             }
         }
         let truth_row = truth_at(ctx, &f, idx as i64, t, &mut prev_robot);
-        tracks.extend(step_all(ctx, &mut runners, &omni, &f, &pose, idx as i64, t)?);
+        tracks.extend(step_all(
+            ctx,
+            &mut runners,
+            &omni,
+            &f,
+            &pose,
+            idx as i64,
+            t,
+        )?);
         truth_rows.extend(truth_row);
         if idx % 50 == 0 {
             bar.set_message(&format!("scan {idx}"));
@@ -276,7 +296,15 @@ fn step_all(
         let out = r
             .step(&obs, f.scan.ranges.len(), Some(pose))
             .with_context(|| format!("{}: {name} at scan {idx}", ctx.log.path().display()))?;
-        rows.push(track_row(ctx, name, idx, t, &out, map_from_fixed.as_ref(), people));
+        rows.push(track_row(
+            ctx,
+            name,
+            idx,
+            t,
+            &out,
+            map_from_fixed.as_ref(),
+            people,
+        ));
     }
     Ok(rows)
 }
@@ -298,11 +326,7 @@ fn track_row(
     let (mut target_err, mut nearest) = (None, None);
     if let (Some((x, y, ..)), Some(frame)) = (est, people) {
         let d = |q: &crate::groundtruth::PersonTruth| (q.x - x).hypot(q.y - y);
-        target_err = frame
-            .people
-            .iter()
-            .find(|q| q.id == ctx.p.target_id)
-            .map(d);
+        target_err = frame.people.iter().find(|q| q.id == ctx.p.target_id).map(d);
         nearest = frame
             .people
             .iter()

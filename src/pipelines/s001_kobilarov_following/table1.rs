@@ -13,9 +13,8 @@
 //!   person. The paper: 21 resets in 12 runs, 17 re-acquired right, 19 by the ground, 2 by long
 //!   occlusions.
 
-use super::aggregate::SessionData;
 use super::params::Params;
-use super::tables::{LoopRow, TruthRow};
+use super::tables::{LoopRow, SessionData, TruthRow};
 use crate::eval::stats;
 use crate::report::rows::Rows;
 use crate::report::table::Table;
@@ -112,7 +111,13 @@ pub fn run_values(truth: &[TruthRow], p: &Params) -> Option<[f64; 5]> {
     ])
 }
 
-fn row(source: &str, run: &str, controller: &str, d: Option<f64>, v: Option<[f64; 5]>) -> Table1Row {
+fn row(
+    source: &str,
+    run: &str,
+    controller: &str,
+    d: Option<f64>,
+    v: Option<[f64; 5]>,
+) -> Table1Row {
     Table1Row {
         source: source.into(),
         run: run.into(),
@@ -138,10 +143,13 @@ pub fn table1_rows(data: &[&SessionData], p: &Params) -> Vec<Table1Row> {
         out.push(row("ours", &d.name, controller, dur, v));
     }
     let col = |i: usize| values.iter().map(|v| v[i]).collect::<Vec<f64>>();
-    let summaries: Vec<Option<stats::Summary>> = (0..5).map(|i| stats::describe(&col(i)).ok()).collect();
+    let summaries: Vec<Option<stats::Summary>> =
+        (0..5).map(|i| stats::describe(&col(i)).ok()).collect();
     let pick = |f: fn(&stats::Summary) -> f64| {
         let v: Vec<Option<f64>> = summaries.iter().map(|s| s.as_ref().map(f)).collect();
-        v.iter().all(Option::is_some).then(|| [0, 1, 2, 3, 4].map(|i| v[i].unwrap_or(f64::NAN)))
+        v.iter()
+            .all(Option::is_some)
+            .then(|| [0, 1, 2, 3, 4].map(|i| v[i].unwrap_or(f64::NAN)))
     };
     out.push(row("ours", "mean", "", None, pick(|s| s.mean)));
     out.push(row("ours", "std", "", None, pick(|s| s.std)));
@@ -164,7 +172,11 @@ pub fn events(d: &SessionData, p: &Params) -> Vec<RstRow> {
             .collect();
         let n = before.len().max(1) as f64;
         let share = |f: fn(&TruthRow) -> bool| before.iter().filter(|q| f(q)).count() as f64 / n;
-        let (g, o, v) = (share(|q| q.ground), share(|q| q.occluded), share(|q| q.out_of_view));
+        let (g, o, v) = (
+            share(|q| q.ground),
+            share(|q| q.occluded),
+            share(|q| q.out_of_view),
+        );
         let cause = if g.max(o).max(v) < 0.3 {
             "other"
         } else if g >= o && g >= v {
@@ -236,7 +248,13 @@ pub fn tables(data: &[&SessionData], p: &Params) -> anyhow::Result<Vec<Table>> {
         "rst events of the closed loop: cause from the ground truth of the 3 s before, re-acquisition",
         RstRow::frame(&ev)?,
     );
-    for c in ["t_s", "ground_share", "occlusion_share", "out_of_view_share", "lost_s"] {
+    for c in [
+        "t_s",
+        "ground_share",
+        "occlusion_share",
+        "out_of_view_share",
+        "lost_s",
+    ] {
         te = te.with_precision(c, 2);
     }
     let mut sum: Vec<RstSummaryRow> = data
@@ -270,7 +288,8 @@ pub fn summary(data: &[&SessionData], p: &Params) -> Vec<String> {
     let rows = table1_rows(data, p);
     let mut out = Vec::new();
     if let Some(m) = rows.iter().find(|r| r.source == "ours" && r.run == "mean")
-        && let (Some(r), Some(b), Some(v), Some(e), Some(x)) = (m.r_avg, m.b_avg, m.v_avg, m.err_avg, m.v_max)
+        && let (Some(r), Some(b), Some(v), Some(e), Some(x)) =
+            (m.r_avg, m.b_avg, m.v_avg, m.err_avg, m.v_max)
     {
         out.push(format!(
             "Table I over {} runs: r_avg {r:.2} m, b_avg {b:.2} rad, v_avg {v:.2} m/s, err_avg {e:.2} m, v_max {x:.2} m/s (paper: 4.04, 0.15, 1.50, 0.30, 2.06)",

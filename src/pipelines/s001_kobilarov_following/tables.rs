@@ -4,7 +4,7 @@
 use anyhow::Context;
 
 use crate::report::rows::Rows;
-use crate::run::SessionTables;
+use crate::run::{Aggregate, SessionTables};
 use crate::table_row;
 
 pub const TRACKS: &str = "tracks";
@@ -125,4 +125,44 @@ pub fn read<R: Rows>(tables: &SessionTables, name: &str, session: &str) -> anyho
         .get(name)
         .with_context(|| format!("{session}: cached result lacks the {name} table"))?;
     R::read(df).with_context(|| format!("{session}: reading the cached {name} table"))
+}
+
+/// One session's cached rows.
+pub struct SessionData {
+    pub name: String,
+    pub tracks: Vec<TrackRow>,
+    pub truth: Vec<TruthRow>,
+    pub closed_loop: Vec<LoopRow>,
+    pub method1: Vec<Method1Row>,
+    pub real: Vec<RealRow>,
+}
+
+impl SessionData {
+    /// A real log (its rows are in `real` only).
+    pub fn is_real(&self) -> bool {
+        !self.real.is_empty()
+    }
+
+    /// One method's rows, in scan order.
+    pub fn method<'a>(&'a self, name: &'a str) -> impl Iterator<Item = &'a TrackRow> + 'a {
+        self.tracks.iter().filter(move |r| r.method == name)
+    }
+}
+
+/// Every session, in the runner's (sorted) order.
+pub fn load(ctx: &Aggregate) -> anyhow::Result<Vec<SessionData>> {
+    ctx.sessions
+        .iter()
+        .map(|(info, t)| {
+            let name = info.name.clone();
+            Ok(SessionData {
+                tracks: read(t, TRACKS, &name)?,
+                truth: read(t, TRUTH, &name)?,
+                closed_loop: read(t, LOOP, &name)?,
+                method1: read(t, METHOD1, &name)?,
+                real: read(t, REAL, &name)?,
+                name,
+            })
+        })
+        .collect()
 }

@@ -17,7 +17,10 @@ pub struct PdafFollower {
 impl PdafFollower {
     pub fn new(spec: &FollowSpec, init: [f64; 2]) -> PdafFollower {
         PdafFollower {
-            tracker: FollowTracker::new(&spec.params(ModelKind::Ct, AssociationKind::Pdaf, true), init),
+            tracker: FollowTracker::new(
+                &spec.params(ModelKind::Ct, AssociationKind::Pdaf, true),
+                init,
+            ),
         }
     }
 }
