@@ -133,9 +133,8 @@ impl Follower for NearestBlobFollower {
         ];
         match nearest_cluster(&points, predicted, GATE_M) {
             Some(c) if dt > 0.0 => {
-                for k in 0..2 {
-                    let measured = (c[k] - tr.position[k]) / dt;
-                    tr.velocity[k] += VELOCITY_GAIN * (measured - tr.velocity[k]);
+                for ((v, ck), pk) in tr.velocity.iter_mut().zip(c).zip(tr.position) {
+                    *v += VELOCITY_GAIN * ((ck - pk) / dt - *v);
                 }
                 tr.position = c;
                 tr.t_seen = t;

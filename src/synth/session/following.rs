@@ -13,7 +13,9 @@ use crate::geometry::camera::CameraModel;
 use crate::groundtruth::FollowerState;
 use crate::laser::points::ScanGeometry;
 use crate::log::SessionWriter;
-use crate::synth::follow::closed_loop::{self, CaptureEvent, ClosedLoop, LoopSpec, Sensed, Sensors};
+use crate::synth::follow::closed_loop::{
+    self, CaptureEvent, ClosedLoop, LoopSpec, Sensed, Sensors,
+};
 use crate::synth::follow::make_follower;
 use crate::synth::world::Primitive;
 
@@ -31,18 +33,22 @@ impl Sensors for LoopSensors<'_> {
     type Error = SynthError;
 
     fn events(&self, omni: bool) -> Vec<CaptureEvent> {
-        schedule(&self.rig.sensors, self.ses.seed, self.ses.s.scenario.duration_s)
-            .into_iter()
-            .filter_map(|(t_ns, sensor, n)| {
-                let is_omni = omni && Some(sensor) == self.omni;
-                (sensor == self.laser || is_omni).then_some(CaptureEvent {
-                    t_ns,
-                    sensor,
-                    n,
-                    omni: is_omni,
-                })
+        schedule(
+            &self.rig.sensors,
+            self.ses.seed,
+            self.ses.s.scenario.duration_s,
+        )
+        .into_iter()
+        .filter_map(|(t_ns, sensor, n)| {
+            let is_omni = omni && Some(sensor) == self.omni;
+            (sensor == self.laser || is_omni).then_some(CaptureEvent {
+                t_ns,
+                sensor,
+                n,
+                omni: is_omni,
             })
-            .collect()
+        })
+        .collect()
     }
 
     fn capture(
@@ -72,12 +78,13 @@ impl Sensors for LoopSensors<'_> {
             }
             SensorRuntime::Camera(c) => {
                 let (frame, _) = self.ses.render_camera(c, (ev.sensor, ev.n), &scene);
-                let image = RgbImage::from_raw(frame.width, frame.height, frame.rgb).ok_or_else(
-                    || SynthError::Encode {
-                        camera: c.frame_id.clone(),
-                        reason: "frame size".into(),
-                    },
-                )?;
+                let image =
+                    RgbImage::from_raw(frame.width, frame.height, frame.rgb).ok_or_else(|| {
+                        SynthError::Encode {
+                            camera: c.frame_id.clone(),
+                            reason: "frame size".into(),
+                        }
+                    })?;
                 Ok(Sensed::Omni {
                     stamp: scene.stamp,
                     image,
@@ -91,12 +98,19 @@ impl Sensors for LoopSensors<'_> {
 
 /// Run the closed loop of session `session` when the scenario asks for one: `None` for an
 /// open-loop scenario. `ses` is the session with the nominal (open-loop) robot track.
-pub(super) fn run(ses: &Session, rig: &Rig, session: u64) -> Result<Option<ClosedLoop>, SynthError> {
+pub(super) fn run(
+    ses: &Session,
+    rig: &Rig,
+    session: u64,
+) -> Result<Option<ClosedLoop>, SynthError> {
     let s = ses.s;
     let Some(f) = s.robot.follow.as_ref().filter(|f| f.closed_loop) else {
         return Ok(None);
     };
-    let laser = rig.sensors.iter().position(|x| matches!(x, SensorRuntime::Laser(l) if l.on_robot));
+    let laser = rig
+        .sensors
+        .iter()
+        .position(|x| matches!(x, SensorRuntime::Laser(l) if l.on_robot));
     let Some(laser) = laser else {
         return Err(SynthError::Scenario(
             "robot.follow.closed_loop needs a laser on the robot".into(),
