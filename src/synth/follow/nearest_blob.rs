@@ -22,8 +22,10 @@ pub const GATE_M: f64 = 0.8;
 pub const CLUSTER_M: f64 = 0.45;
 /// Consecutive returns farther apart than this start a new segment (m).
 pub const SEGMENT_JUMP_M: f64 = 0.1;
-/// Segments wider than this (first to last return) are not legs (m).
-pub const LEG_MAX_WIDTH_M: f64 = 0.45;
+/// Segments wider than this (first to last return) are not legs (m): a leg is 0.11–0.15 m
+/// across, with room for a slanted view; two legs seen as one segment drop out (the track
+/// coasts for that scan).
+pub const LEG_MAX_WIDTH_M: f64 = 0.25;
 /// Time without a return in the gate after which the target is lost (s).
 pub const LOST_AFTER_S: f64 = 1.0;
 /// Radius around the initial point, and around the last estimate once lost, in which a
