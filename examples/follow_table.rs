@@ -34,7 +34,9 @@ fn main() -> Res<()> {
             _ => logs.push(a),
         }
     }
-    println!("| session | controller | range m | abs bearing deg | speed m/s | E_follow m | max speed m/s | rst | lost % |");
+    println!(
+        "| session | controller | range m | abs bearing deg | speed m/s | E_follow m | max speed m/s | rst | lost % |"
+    );
     println!("|---|---|---|---|---|---|---|---|---|");
     for path in &logs {
         let log = SessionLog::open(std::path::Path::new(path))?;
@@ -79,7 +81,10 @@ fn main() -> Res<()> {
         };
         println!(
             "| {} | {controller} | {} | {} | {} | {} | {:.2} | {rst} | {:.1} |",
-            std::path::Path::new(path).file_stem().and_then(|s| s.to_str()).unwrap_or("?"),
+            std::path::Path::new(path)
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("?"),
             f(&range),
             f(&bearing),
             f(&speed),

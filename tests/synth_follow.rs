@@ -47,7 +47,10 @@ fn closed_loop_logs_are_identical_on_one_and_two_threads_and_follow_the_walker()
     let b = synth(&scenario(), &dir.path().join("two"), 2);
     assert_eq!(a.len(), 2);
     for (x, y) in a.iter().zip(&b) {
-        let (bx, by) = (std::fs::read(x).expect("read"), std::fs::read(y).expect("read"));
+        let (bx, by) = (
+            std::fs::read(x).expect("read"),
+            std::fs::read(y).expect("read"),
+        );
         assert!(bx == by, "{} differs between 1 and 2 threads", x.display());
     }
     for (k, path) in a.iter().enumerate() {
@@ -66,12 +69,17 @@ fn closed_loop_logs_are_identical_on_one_and_two_threads_and_follow_the_walker()
         let expected = ["pursuit", "direct"][k];
         assert!(states.iter().all(|s| s.controller == expected));
         let tracked = states.iter().filter(|s| s.position.is_some()).count();
-        assert!(tracked * 10 >= states.len() * 9, "{tracked} of {}", states.len());
+        assert!(
+            tracked * 10 >= states.len() * 9,
+            "{tracked} of {}",
+            states.len()
+        );
         // the estimate is near the walker's true position (odom = map shifted to the start)
         let people: Vec<PeopleFrame> = json(&log, "/ground_truth/people");
         let mut errors = Vec::new();
         for s in &states {
-            let (Some(p), Some(gt)) = (s.position, people.iter().find(|g| g.stamp_ns == s.stamp_ns))
+            let (Some(p), Some(gt)) =
+                (s.position, people.iter().find(|g| g.stamp_ns == s.stamp_ns))
             else {
                 continue;
             };
@@ -92,14 +100,21 @@ fn closed_loop_logs_are_identical_on_one_and_two_threads_and_follow_the_walker()
         let median = sorted[sorted.len() / 2];
         let p90 = sorted[sorted.len() * 9 / 10];
         eprintln!("session {k}: estimate error median {median:.3} p90 {p90:.3} m");
-        assert!(median < 0.3 && p90 < 0.8, "median {median} p90 {p90}: {errors:.2?}");
+        assert!(
+            median < 0.3 && p90 < 0.8,
+            "median {median} p90 {p90}: {errors:.2?}"
+        );
         // the robot drove after the walker
         let odom: Vec<_> = read_topic::<Odometry>(&log, "/odom")
             .expect("odom")
             .map(|r| r.expect("ok").1)
             .collect();
         let last = odom.last().expect("odometry");
-        assert!(last.pose.position.x > 2.0, "odom x {}", last.pose.position.x);
+        assert!(
+            last.pose.position.x > 2.0,
+            "odom x {}",
+            last.pose.position.x
+        );
     }
 }
 
@@ -114,5 +129,8 @@ fn an_open_loop_copy_has_no_follower_channel() {
     let sessions = synth(&path, &dir.path().join("out"), 1);
     let log = SessionLog::open(&sessions[0]).expect("opens");
     assert!(log.messages_on(&["/scan"]).is_ok());
-    assert!(log.messages_on(&["/follower/state"]).is_err(), "no follower channel");
+    assert!(
+        log.messages_on(&["/follower/state"]).is_err(),
+        "no follower channel"
+    );
 }

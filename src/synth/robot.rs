@@ -301,7 +301,11 @@ impl Odometer {
         let (tk, [x, y, yaw], v, w) = *self.samples.get(k.checked_sub(1)?)?;
         let h = t - tk;
         Some((
-            [x + v * yaw.cos() * h, y + v * yaw.sin() * h, wrap(yaw + w * h)],
+            [
+                x + v * yaw.cos() * h,
+                y + v * yaw.sin() * h,
+                wrap(yaw + w * h),
+            ],
             v,
         ))
     }

@@ -22,7 +22,7 @@ use crate::laser::points::ScanGeometry;
 use crate::rng;
 use crate::synth::motion::DT;
 use crate::synth::robot::{
-    self, OdometrySample, Odometer, PITCH_JITTER_RAD, RobotState, RobotTrack,
+    self, Odometer, OdometrySample, PITCH_JITTER_RAD, RobotState, RobotTrack,
 };
 use crate::synth::scenario::{Controller, Follow, Robot};
 use crate::time::Nanos;

@@ -1,5 +1,6 @@
 //! The placeholder baseline estimator of the closed loop (not a paper method): the cluster
-//! of laser returns nearest to the last estimate's prediction, within a gate. It starts on
+//! of leg-sized laser segments (at most [`LEG_MAX_WIDTH_M`] wide) nearest to the last
+//! estimate's prediction, within a gate. It starts on
 //! the cluster nearest to a given point (where a person points the robot at its target),
 //! coasts on its velocity while nothing is in the gate, and after [`LOST_AFTER_S`] without
 //! a return declares the target lost (`rst`): it then answers `None` until a cluster appears
@@ -13,11 +14,18 @@ use nalgebra::Point2;
 
 use super::{Estimate, Follower, FollowerOutput, ScanInput};
 use crate::laser::points::project;
+use crate::laser::segment::{SegmentOptions, Threshold, segment};
 
 /// Radius of the gate around the predicted position (m).
 pub const GATE_M: f64 = 0.8;
-/// Returns within this distance of the nearest return form the target's cluster: both legs (m).
+/// Leg candidates within this distance of the nearest one form the target: both legs (m).
 pub const CLUSTER_M: f64 = 0.45;
+/// Consecutive returns farther apart than this start a new segment (m).
+pub const SEGMENT_JUMP_M: f64 = 0.1;
+/// Segments wider than this (first to last return) are not legs (m): a leg is 0.11–0.15 m
+/// across, with room for a slanted view; two legs seen as one segment drop out (the track
+/// coasts for that scan).
+pub const LEG_MAX_WIDTH_M: f64 = 0.25;
 /// Time without a return in the gate after which the target is lost (s).
 pub const LOST_AFTER_S: f64 = 1.0;
 /// Radius around the initial point, and around the last estimate once lost, in which a
@@ -68,8 +76,34 @@ impl NearestBlobFollower {
     }
 }
 
-/// Centroid of the returns within [`CLUSTER_M`] of the return nearest to `at`, when that
-/// return is within `gate` of `at`.
+/// Leg-sized pieces of a scan: the centroids (in the pose's frame) of the jump-distance
+/// segments no wider than [`LEG_MAX_WIDTH_M`]. Bushes, walls and the ground line a pitched
+/// laser draws are wider, and are not candidates.
+fn leg_candidates(input: &ScanInput<'_>) -> Vec<Point2<f64>> {
+    let points = project(input.ranges, &input.geometry, Some(&input.laser_pose));
+    let options = SegmentOptions {
+        threshold: Threshold::Fixed(SEGMENT_JUMP_M),
+        min_points: 1,
+    };
+    segment(&points, &options)
+        .into_iter()
+        .filter_map(|seg| {
+            let pts = &points[seg.points];
+            let (first, last) = (pts.first()?, pts.last()?);
+            if (last.sensor - first.sensor).norm() > LEG_MAX_WIDTH_M {
+                return None;
+            }
+            let n = pts.len() as f64;
+            let (sx, sy) = pts
+                .iter()
+                .fold((0.0, 0.0), |(x, y), p| (x + p.fixed.x, y + p.fixed.y));
+            Some(Point2::new(sx / n, sy / n))
+        })
+        .collect()
+}
+
+/// Mean of the candidates within [`CLUSTER_M`] of the candidate nearest to `at`, when that
+/// one is within `gate` of `at` (both legs of a person).
 fn nearest_cluster(points: &[Point2<f64>], at: [f64; 2], gate: f64) -> Option<[f64; 2]> {
     let at = Point2::new(at[0], at[1]);
     let nearest = points
@@ -99,11 +133,7 @@ fn estimate(track: &TrackState, t: f64) -> Estimate {
 impl Follower for NearestBlobFollower {
     fn on_scan(&mut self, input: &ScanInput<'_>) -> FollowerOutput {
         let t = input.t;
-        let points: Vec<Point2<f64>> =
-            project(input.ranges, &input.geometry, Some(&input.laser_pose))
-                .into_iter()
-                .map(|p| p.fixed)
-                .collect();
+        let points = leg_candidates(input);
         let Some(tr) = self.track.as_mut() else {
             // (re)initialise on the cluster nearest to the anchor
             let (centre, radius) = self.search(t);
@@ -133,9 +163,8 @@ impl Follower for NearestBlobFollower {
         ];
         match nearest_cluster(&points, predicted, GATE_M) {
             Some(c) if dt > 0.0 => {
-                for k in 0..2 {
-                    let measured = (c[k] - tr.position[k]) / dt;
-                    tr.velocity[k] += VELOCITY_GAIN * (measured - tr.velocity[k]);
+                for ((v, ck), pk) in tr.velocity.iter_mut().zip(c).zip(tr.position) {
+                    *v += VELOCITY_GAIN * ((ck - pk) / dt - *v);
                 }
                 tr.position = c;
                 tr.t_seen = t;

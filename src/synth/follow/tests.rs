@@ -63,7 +63,10 @@ fn a_still_target_straight_ahead_at_the_desired_distance_needs_no_command() {
     }
     // farther: drive; nearer: stand
     assert!(controller::direct(&at_origin(0.0), &still(3.0, 0.0), &lim).v > 0.0);
-    assert_eq!(controller::direct(&at_origin(0.0), &still(1.0, 0.0), &lim).v, 0.0);
+    assert_eq!(
+        controller::direct(&at_origin(0.0), &still(1.0, 0.0), &lim).v,
+        0.0
+    );
 }
 
 #[test]
@@ -168,7 +171,10 @@ fn nearest_blob_starts_on_the_nearest_cluster_follows_it_and_loses_it() {
     let out = f.on_scan(&input(0.0, &r, g));
     let e = out.estimate.expect("initialised");
     // the legs' front surfaces: a little in front of x = 2, between them in y
-    assert!((e.position[0] - 1.96).abs() < 0.04 && e.position[1].abs() < 0.02, "{e:?}");
+    assert!(
+        (e.position[0] - 1.96).abs() < 0.04 && e.position[1].abs() < 0.02,
+        "{e:?}"
+    );
     // walking away at 1 m/s, seen every 0.1 s
     let mut last = e;
     for k in 1..=10 {
@@ -196,7 +202,10 @@ fn nearest_blob_starts_on_the_nearest_cluster_follows_it_and_loses_it() {
         }
     }
     assert_eq!(resets.len(), 1, "{resets:?}");
-    assert!((resets[0] - (1.0 + LOST_AFTER_S + 0.1)).abs() < 1e-9, "{resets:?}");
+    assert!(
+        (resets[0] - (1.0 + LOST_AFTER_S + 0.1)).abs() < 1e-9,
+        "{resets:?}"
+    );
     assert_eq!(f.on_scan(&input(3.1, &r, g)).estimate, None);
 }
 
@@ -239,7 +248,11 @@ struct DiscWorld {
 impl DiscWorld {
     fn person(&self, t: f64) -> [f64; 2] {
         let s = self.speed * t;
-        if s < 9.0 { [3.0 + s, 0.5] } else { [12.0, 0.5 + s - 9.0] }
+        if s < 9.0 {
+            [3.0 + s, 0.5]
+        } else {
+            [12.0, 0.5 + s - 9.0]
+        }
     }
 }
 
@@ -257,7 +270,11 @@ impl Sensors for DiscWorld {
             .collect()
     }
 
-    fn capture(&mut self, ev: &CaptureEvent, map_from_base: &Isometry3<f64>) -> Result<Sensed, Infallible> {
+    fn capture(
+        &mut self,
+        ev: &CaptureEvent,
+        map_from_base: &Isometry3<f64>,
+    ) -> Result<Sensed, Infallible> {
         let t = ev.t_ns as f64 * 1e-9;
         let p = self.person(t);
         let laser_from_map = (map_from_base * self.base_from_laser).inverse();
@@ -309,19 +326,30 @@ fn the_closed_loop_follows_a_walker_with_both_controllers() {
         let mut f = NearestBlobFollower::new([3.0, 0.5]);
         let run = run_disc_world(controller, &mut f);
         assert_eq!(run.scans.len(), 150);
-        assert!(run.scans.iter().all(|s| s.output.estimate.is_some()), "{controller:?} lost it");
+        assert!(
+            run.scans.iter().all(|s| s.output.estimate.is_some()),
+            "{controller:?} lost it"
+        );
         // after the start-up, the range stays near the following distance and the robot
         // moves at the walker's speed
         for t in [6.0, 10.0, 14.0] {
             let s = run.track.state(t);
             let p = world.person(t);
             let range = (p[0] - s.x).hypot(p[1] - s.y);
-            assert!(range > 1.5 && range < 3.5, "{controller:?} t {t}: range {range}");
+            assert!(
+                range > 1.5 && range < 3.5,
+                "{controller:?} t {t}: range {range}"
+            );
         }
         let s = run.track.state(14.0);
         assert!((s.v - 1.2).abs() < 0.4, "{controller:?}: v {}", s.v);
         // it pitched while accelerating
-        let max_pitch = run.track.samples.iter().map(|s| s.pitch).fold(0.0, f64::max);
+        let max_pitch = run
+            .track
+            .samples
+            .iter()
+            .map(|s| s.pitch)
+            .fold(0.0, f64::max);
         assert!(max_pitch.to_degrees() > 3.0);
         // the loop's odometry is the one the log gets
         let odo = robot::odometry(&run.track, [0.02, 0.01], 50.0, 15.0, 7, 0);
@@ -365,6 +393,9 @@ fn a_lost_target_stops_the_robot_at_its_deceleration_limit() {
     let early = ((first_none.t + v0 / 2.0 - 3.0 * DT) / DT) as usize;
     assert!(run.track.samples[early].v > 0.0);
     // it pitches backwards while braking
-    let min_pitch = run.track.samples[i - 60..i].iter().map(|s| s.pitch).fold(0.0, f64::min);
+    let min_pitch = run.track.samples[i - 60..i]
+        .iter()
+        .map(|s| s.pitch)
+        .fold(0.0, f64::min);
     assert!(min_pitch.to_degrees() < -3.0, "{}", min_pitch.to_degrees());
 }

@@ -101,16 +101,28 @@ pub(super) fn follow_problem(f: &Follow, sensors: &[SensorSpec]) -> Option<(Stri
 /// The first problem of a `[robot.follow]` table's closed-loop keys: `(key, reason)`.
 fn loop_problem(f: &Follow, sensors: &[SensorSpec]) -> Option<(&'static str, String)> {
     if !(f.max_speed > 0.0 && f.max_accel > 0.0) {
-        return Some(("max_speed", "max_speed and max_accel must be positive".into()));
+        return Some((
+            "max_speed",
+            "max_speed and max_accel must be positive".into(),
+        ));
     }
     if f.max_decel.is_some_and(|a| !(a > 0.0 && a.is_finite())) {
-        return Some(("max_decel", format!("{:?} is not a positive deceleration", f.max_decel)));
+        return Some((
+            "max_decel",
+            format!("{:?} is not a positive deceleration", f.max_decel),
+        ));
     }
     if !(f.max_turn_rate > 0.0 && f.max_turn_rate.is_finite()) {
-        return Some(("max_turn_rate", format!("{} is not positive", f.max_turn_rate)));
+        return Some((
+            "max_turn_rate",
+            format!("{} is not positive", f.max_turn_rate),
+        ));
     }
     if f.controllers.is_empty() {
-        return Some(("controllers", "name at least one of \"pursuit\", \"direct\"".into()));
+        return Some((
+            "controllers",
+            "name at least one of \"pursuit\", \"direct\"".into(),
+        ));
     }
     let robot_laser = sensors
         .iter()

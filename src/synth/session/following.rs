@@ -1,7 +1,9 @@
 //! The closed following loop of a session (`[robot.follow] closed_loop = true`): the rig's
 //! follower laser and omni camera as the loop's [`Sensors`] (the same scenes, noise keys and
 //! schedule as the capture stage, so the loop reads exactly what is logged), the follower the
-//! scenario names, and the follower's per-scan state on `/follower/state`.
+//! scenario names, and the follower's per-scan state on `/follower/state`. The robot starts
+//! in front of its target, facing it (the scenario's `[robot] pose` gives the direction it
+//! comes from); the crowd's crossers are still planned against the open-loop robot.
 
 use image::RgbImage;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion};
@@ -13,9 +15,15 @@ use crate::geometry::camera::CameraModel;
 use crate::groundtruth::FollowerState;
 use crate::laser::points::ScanGeometry;
 use crate::log::SessionWriter;
-use crate::synth::follow::closed_loop::{self, CaptureEvent, ClosedLoop, LoopSpec, Sensed, Sensors};
+use crate::synth::follow::closed_loop::{
+    self, CaptureEvent, ClosedLoop, LoopSpec, Sensed, Sensors,
+};
 use crate::synth::follow::make_follower;
 use crate::synth::world::Primitive;
+
+/// A closed loop starts the robot at most this far (m) beyond the following distance from
+/// its target, facing it.
+const START_GAP_M: f64 = 1.0;
 
 /// The rig's sensors that feed the follower.
 struct LoopSensors<'a> {
@@ -31,18 +39,22 @@ impl Sensors for LoopSensors<'_> {
     type Error = SynthError;
 
     fn events(&self, omni: bool) -> Vec<CaptureEvent> {
-        schedule(&self.rig.sensors, self.ses.seed, self.ses.s.scenario.duration_s)
-            .into_iter()
-            .filter_map(|(t_ns, sensor, n)| {
-                let is_omni = omni && Some(sensor) == self.omni;
-                (sensor == self.laser || is_omni).then_some(CaptureEvent {
-                    t_ns,
-                    sensor,
-                    n,
-                    omni: is_omni,
-                })
+        schedule(
+            &self.rig.sensors,
+            self.ses.seed,
+            self.ses.s.scenario.duration_s,
+        )
+        .into_iter()
+        .filter_map(|(t_ns, sensor, n)| {
+            let is_omni = omni && Some(sensor) == self.omni;
+            (sensor == self.laser || is_omni).then_some(CaptureEvent {
+                t_ns,
+                sensor,
+                n,
+                omni: is_omni,
             })
-            .collect()
+        })
+        .collect()
     }
 
     fn capture(
@@ -72,12 +84,13 @@ impl Sensors for LoopSensors<'_> {
             }
             SensorRuntime::Camera(c) => {
                 let (frame, _) = self.ses.render_camera(c, (ev.sensor, ev.n), &scene);
-                let image = RgbImage::from_raw(frame.width, frame.height, frame.rgb).ok_or_else(
-                    || SynthError::Encode {
-                        camera: c.frame_id.clone(),
-                        reason: "frame size".into(),
-                    },
-                )?;
+                let image =
+                    RgbImage::from_raw(frame.width, frame.height, frame.rgb).ok_or_else(|| {
+                        SynthError::Encode {
+                            camera: c.frame_id.clone(),
+                            reason: "frame size".into(),
+                        }
+                    })?;
                 Ok(Sensed::Omni {
                     stamp: scene.stamp,
                     image,
@@ -91,12 +104,19 @@ impl Sensors for LoopSensors<'_> {
 
 /// Run the closed loop of session `session` when the scenario asks for one: `None` for an
 /// open-loop scenario. `ses` is the session with the nominal (open-loop) robot track.
-pub(super) fn run(ses: &Session, rig: &Rig, session: u64) -> Result<Option<ClosedLoop>, SynthError> {
+pub(super) fn run(
+    ses: &Session,
+    rig: &Rig,
+    session: u64,
+) -> Result<Option<ClosedLoop>, SynthError> {
     let s = ses.s;
     let Some(f) = s.robot.follow.as_ref().filter(|f| f.closed_loop) else {
         return Ok(None);
     };
-    let laser = rig.sensors.iter().position(|x| matches!(x, SensorRuntime::Laser(l) if l.on_robot));
+    let laser = rig
+        .sensors
+        .iter()
+        .position(|x| matches!(x, SensorRuntime::Laser(l) if l.on_robot));
     let Some(laser) = laser else {
         return Err(SynthError::Scenario(
             "robot.follow.closed_loop needs a laser on the robot".into(),
@@ -113,15 +133,29 @@ pub(super) fn run(ses: &Session, rig: &Rig, session: u64) -> Result<Option<Close
         .find(|a| a.body.id == f.target)
         .and_then(|a| a.track.position(a.track.start))
         .ok_or_else(|| SynthError::Scenario("robot.follow.target is never present".into()))?;
+    // ... standing in front of it, as the paper's runs start: the robot starts facing the
+    // target, at most START_GAP_M beyond the following distance from it on the line from the
+    // scenario's start position (a 180° laser with a 20 m range sees nothing behind or far)
+    let mut robot = s.robot.clone();
+    let (dx, dy) = (target.0 - robot.pose[0], target.1 - robot.pose[1]);
+    let dist = dx.hypot(dy);
+    let gap = dist.min(f.distance + START_GAP_M);
+    if dist > 0.0 {
+        robot.pose = [
+            target.0 - dx / dist * gap,
+            target.1 - dy / dist * gap,
+            dy.atan2(dx).to_degrees(),
+        ];
+    }
     let start = Isometry3::from_parts(
-        Translation3::new(s.robot.pose[0], s.robot.pose[1], 0.0),
-        UnitQuaternion::from_euler_angles(0.0, 0.0, s.robot.pose[2].to_radians()),
+        Translation3::new(robot.pose[0], robot.pose[1], 0.0),
+        UnitQuaternion::from_euler_angles(0.0, 0.0, robot.pose[2].to_radians()),
     );
     let init = start.inverse() * Point3::new(target.0, target.1, 0.0);
     let mut follower = make_follower(f, [init.x, init.y]);
     let controller = f.controllers[session as usize % f.controllers.len().max(1)];
     let spec = LoopSpec {
-        robot: &s.robot,
+        robot: &robot,
         follow: f,
         controller,
         duration: s.scenario.duration_s,
