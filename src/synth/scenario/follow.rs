@@ -135,3 +135,33 @@ fn loop_problem(f: &Follow, sensors: &[SensorSpec]) -> Option<(&'static str, Str
     }
     None
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(extra: &str) -> Follow {
+        toml::from_str(&format!(
+            "target = 1\ndistance = 1.8\nmax_speed = 2.0\nmax_accel = 1.0\n{extra}"
+        ))
+        .expect("parses")
+    }
+
+    #[test]
+    fn closed_loop_keys_default_and_their_problems_name_the_key() {
+        let f = parse("");
+        assert!(!f.closed_loop);
+        assert_eq!(f.controllers, vec![Controller::Pursuit, Controller::Direct]);
+        assert_eq!(f.estimator, Estimator::NearestBlob);
+        assert_eq!(f.decel(), 1.0);
+        assert_eq!(follow_problem(&f, &[]), None);
+        let key = |extra: &str| follow_problem(&parse(extra), &[]).map(|p| p.0);
+        assert_eq!(key("controllers = []"), Some("controllers"));
+        assert_eq!(key("max_decel = -1.0"), Some("max_decel"));
+        assert_eq!(key("max_turn_rate = 0.0"), Some("max_turn_rate"));
+        // no laser on the robot to close the loop with
+        assert_eq!(key("closed_loop = true"), Some("closed_loop"));
+        assert!(toml::from_str::<Follow>("target = 1\ndistance = 1.8\nmax_speed = 2.0\nmax_accel = 1.0\nestimator = \"pdaf2\"").is_err());
+        assert!(toml::from_str::<Follow>("target = 1\ndistance = 1.8\nmax_speed = 2.0\nmax_accel = 1.0\ncontrollers = [\"wander\"]").is_err());
+    }
+}
