@@ -166,17 +166,17 @@ fn the_closed_loop_is_reproduced_by_its_replay_and_the_robot_keeps_the_person() 
 #[test]
 fn tables_do_not_depend_on_the_thread_count() {
     let f = fixture();
-    let (a, b) = (f.root.join("j1"), f.root.join("j3"));
+    let (a, b) = (f.root.join("j1"), f.root.join("j2"));
     let o = run(f, &a, "1");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let o = run(f, &b, "3");
+    let o = run(f, &b, "2");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let (ta, tb) = (tables(&a), tables(&b));
     assert!(ta.len() >= 8, "{:?}", ta.keys());
     let differ: Vec<&String> = ta.keys().filter(|k| ta.get(*k) != tb.get(*k)).collect();
     assert!(
         differ.is_empty(),
-        "tables differ between -j 1 and -j 3: {differ:?}"
+        "tables differ between -j 1 and -j 2: {differ:?}"
     );
 }
 

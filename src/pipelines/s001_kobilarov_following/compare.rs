@@ -6,6 +6,8 @@
 //! - **colour** (with vs without the likelihood ratio, CT): wrong-target locks — an estimate
 //!   within `lock_m` of another person and farther than that from the target — as the share of
 //!   scans per run, and per occlusion event whether it ended locked on someone else;
+//! - **template** (held as initialised vs updated while tracking, CT with colour): wrong-target
+//!   locks and mean error per run;
 //! - **association** (PDAF vs nearest neighbour, CT without colour): the mean error per run and
 //!   after each occlusion.
 //!
@@ -247,6 +249,28 @@ pub fn ttests(data: &[&SessionData], p: &Params) -> Vec<TestRow> {
             "locked on another person at the window's end (0/1)",
             (c, &events(c, &locked)),
             (nc, &events(nc, &locked)),
+            lvl,
+        ));
+    }
+    let up = params::UPDATED;
+    if has(c) && has(up) {
+        let q = "colour template: held vs updated";
+        let f = |r: &MethodRow| Some(r.wrong_lock);
+        out.push(paired(
+            q,
+            "run",
+            "share of scans locked on another person",
+            (c, &per_run(c, &f)),
+            (up, &per_run(up, &f)),
+            lvl,
+        ));
+        let f = |r: &MethodRow| r.mean_err_m;
+        out.push(paired(
+            q,
+            "run",
+            "mean error (m)",
+            (c, &per_run(c, &f)),
+            (up, &per_run(up, &f)),
             lvl,
         ));
     }

@@ -35,7 +35,11 @@ pub fn method1_table(rows: &[Method1Row], p: &Params) -> anyhow::Result<Table> {
     )))
 }
 
-fn truth_path(truth: &[TruthRow]) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+/// A path of (x, y) points.
+type Path = Vec<(f64, f64)>;
+
+/// The robot's and the person's true paths.
+fn truth_path(truth: &[TruthRow]) -> (Path, Path) {
     let robot = truth.iter().map(|r| (r.robot_x, r.robot_y)).collect();
     let person = truth
         .iter()

@@ -44,6 +44,9 @@ pub struct Params {
     /// Methods replayed on every log, in table order (see [`method`]).
     pub methods: Vec<String>,
     pub follower: FollowSpec,
+    /// Weight of the newest histogram in the updated template (`ct_colour_updated`), per scan
+    /// with an association.
+    pub template_update: f64,
     /// A person within this distance (m, beyond their radius) of the laser's line of sight to
     /// the target, and nearer than it, occludes it.
     pub occlusion_margin_m: f64,
@@ -85,6 +88,7 @@ impl Default for Params {
             max_decel_mps2: 1.4,
             methods: METHODS.iter().map(|m| (*m).to_string()).collect(),
             follower: FollowSpec::default(),
+            template_update: 0.05,
             occlusion_margin_m: 0.1,
             lock_m: 0.5,
             after_occlusion_s: 2.0,
@@ -109,6 +113,9 @@ pub enum Method {
         model: ModelKind,
         association: AssociationKind,
         colour: bool,
+        /// The colour template follows the target (`template_update` per scan) instead of
+        /// staying as taken at initialisation.
+        update: bool,
     },
     /// The laser issue's multi-person tracker (`laser::tracker`), its track nearest the
     /// target followed.
@@ -117,31 +124,35 @@ pub enum Method {
 
 /// The paper's configuration (drives the closed loop): coordinated turn, PDAF, colour.
 pub const PAPER: &str = "ct_colour";
+/// The same with the template updated while tracking (the paper allows both).
+pub const UPDATED: &str = "ct_colour_updated";
 pub const CV: &str = "cv_colour";
 pub const IMM: &str = "imm_colour";
 pub const NO_COLOUR: &str = "ct_no_colour";
 pub const NN: &str = "nn_ct";
 pub const LASER_TRACKER: &str = "laser_tracker";
 /// Every known method, in the default table order.
-pub const METHODS: [&str; 6] = [PAPER, CV, IMM, NO_COLOUR, NN, LASER_TRACKER];
+pub const METHODS: [&str; 7] = [PAPER, UPDATED, CV, IMM, NO_COLOUR, NN, LASER_TRACKER];
 
 /// The method a name stands for.
 pub fn method(name: &str) -> Option<Method> {
     use AssociationKind::{Nearest, Pdaf};
     use ModelKind::{Ct, Cv, Imm};
-    let f = |model, association, colour| {
+    let f = |model, association, colour, update| {
         Some(Method::Follower {
             model,
             association,
             colour,
+            update,
         })
     };
     match name {
-        PAPER => f(Ct, Pdaf, true),
-        CV => f(Cv, Pdaf, true),
-        IMM => f(Imm, Pdaf, true),
-        NO_COLOUR => f(Ct, Pdaf, false),
-        NN => f(Ct, Nearest, false),
+        PAPER => f(Ct, Pdaf, true, false),
+        UPDATED => f(Ct, Pdaf, true, true),
+        CV => f(Cv, Pdaf, true, false),
+        IMM => f(Imm, Pdaf, true, false),
+        NO_COLOUR => f(Ct, Pdaf, false, false),
+        NN => f(Ct, Nearest, false, false),
         LASER_TRACKER => Some(Method::LaserTracker),
         _ => None,
     }
@@ -178,6 +189,12 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
         if !(v.is_finite() && v >= 0.0) {
             out.push((k.into(), format!("{v} must be finite and >= 0")));
         }
+    }
+    if !(p.template_update > 0.0 && p.template_update <= 1.0) {
+        out.push((
+            "template_update".into(),
+            format!("{} is not in (0, 1]", p.template_update),
+        ));
     }
     if !(p.level > 0.0 && p.level < 1.0) {
         out.push(("level".into(), format!("{} is not in (0, 1)", p.level)));

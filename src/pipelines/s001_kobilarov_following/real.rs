@@ -31,6 +31,7 @@ pub fn methods(p: &Params) -> Vec<(String, Method)> {
                 model,
                 association,
                 colour: false,
+                update: false,
             },
             other => other,
         };

@@ -16,7 +16,7 @@ use crate::laser::tracker::{PeopleTracker, TrackerParams};
 /// One method's state over a session.
 pub enum Runner {
     Follower(Box<FollowTracker>),
-    Laser(LaserSelect),
+    Laser(Box<LaserSelect>),
 }
 
 /// The multi-person tracker and the track it follows.
@@ -34,16 +34,20 @@ impl Runner {
                 model,
                 association,
                 colour,
-            } => Runner::Follower(Box::new(FollowTracker::new(
-                &p.follower.params(model, association, colour),
-                init,
-            ))),
-            Method::LaserTracker => Runner::Laser(LaserSelect {
+                update,
+            } => {
+                let mut fp = p.follower.params(model, association, colour);
+                if update {
+                    fp.template_update = p.template_update;
+                }
+                Runner::Follower(Box::new(FollowTracker::new(&fp, init)))
+            }
+            Method::LaserTracker => Runner::Laser(Box::new(LaserSelect {
                 tracker: PeopleTracker::new(TrackerParams::default()),
                 anchor: init,
                 id: None,
                 radius: p.follower.reinit_radius_m,
-            }),
+            })),
         }
     }
 

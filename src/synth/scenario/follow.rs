@@ -156,11 +156,15 @@ mod tests {
         assert_eq!(f.decel(), 1.0);
         assert_eq!(follow_problem(&f, &[]), None);
         let key = |extra: &str| follow_problem(&parse(extra), &[]).map(|p| p.0);
-        assert_eq!(key("controllers = []"), Some("controllers"));
-        assert_eq!(key("max_decel = -1.0"), Some("max_decel"));
-        assert_eq!(key("max_turn_rate = 0.0"), Some("max_turn_rate"));
+        let key = |extra: &str| key(extra).map(|k| k.to_string());
+        let some = |k: &str| Some(k.to_string());
+        assert_eq!(key("controllers = []"), some("controllers"));
+        assert_eq!(key("max_decel = -1.0"), some("max_decel"));
+        assert_eq!(key("max_turn_rate = 0.0"), some("max_turn_rate"));
         // no laser on the robot to close the loop with
-        assert_eq!(key("closed_loop = true"), Some("closed_loop"));
+        assert_eq!(key("closed_loop = true"), some("closed_loop"));
+        // the pdaf estimator's settings are checked and named under `pdaf.`
+        assert_eq!(key("pdaf = { sigma_r = -1.0 }"), some("pdaf.sigma_r"));
         assert!(toml::from_str::<Follow>("target = 1\ndistance = 1.8\nmax_speed = 2.0\nmax_accel = 1.0\nestimator = \"pdaf2\"").is_err());
         assert!(toml::from_str::<Follow>("target = 1\ndistance = 1.8\nmax_speed = 2.0\nmax_accel = 1.0\ncontrollers = [\"wander\"]").is_err());
     }
