@@ -3,8 +3,8 @@
 
 pub mod dataset_quality;
 pub mod laser_people;
-pub mod s001_kobilarov_following;
 pub mod s000_cielniak_omni;
+pub mod s001_kobilarov_following;
 pub mod s002_brooks_height;
 pub mod s003_zivkovic_background;
 pub mod s004_mohedano_multicam;

@@ -271,8 +271,8 @@ fn json_refuses_what_the_decoder_refuses() {
     let r = reg(HEADER_SCHEMA);
     let mut out = Vec::new();
     let short = &HEADER_THEN_F64[..HEADER_THEN_F64.len() - 3];
-    let err = write_json(&r, short, None, &mut FloatText::default(), &mut out)
-        .expect_err("cut payload");
+    let err =
+        write_json(&r, short, None, &mut FloatText::default(), &mut out).expect_err("cut payload");
     assert_eq!(Err(err), decode(&r, short));
     // a huge count of elements that take no bytes on the wire
     let r = reg("t/E[] many\n===\nMSG: t/E\n");

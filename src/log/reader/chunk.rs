@@ -163,8 +163,7 @@ fn all_kept_whole(all: &[u8], keep: &mut dyn FnMut(u16) -> Keep) -> bool {
         let kept = match opcode {
             op::SCHEMA | op::CHANNEL => len <= MAX_DEFINITION_BYTES,
             op::MESSAGE if len >= MESSAGE_HEADER_LEN as u64 => {
-                parse_message_header(&all[body..end])
-                    .is_ok_and(|h| keep(h.channel) == Keep::Whole)
+                parse_message_header(&all[body..end]).is_ok_and(|h| keep(h.channel) == Keep::Whole)
             }
             _ => false,
         };

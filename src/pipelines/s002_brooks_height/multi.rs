@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 
 use super::params::Params;
 use super::tables::{self, CameraObsRow, LaserObsRow, PersonRow};
-use crate::eval::mot::{self, EventKind, Evaluation, Geometry, GroundPoint, MatchRule};
+use crate::eval::mot::{self, Evaluation, EventKind, Geometry, GroundPoint, MatchRule};
 use crate::run::Aggregate;
 use crate::track::height_ekf::SensorAt;
 use crate::track::height_tracks::{MultiTracker, Observation};

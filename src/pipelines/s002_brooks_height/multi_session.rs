@@ -7,10 +7,10 @@
 
 use anyhow::Context;
 
+use super::camera;
 use super::params::Params;
 use super::session::laser_observations;
 use super::tables::{self, CameraObsRow, LaserObsRow, PersonRow};
-use super::camera;
 use crate::frames::{rig, truth};
 use crate::groundtruth::PEOPLE_TOPIC;
 use crate::log::TfBuffer;

@@ -47,13 +47,21 @@ fn open(body: &[u8], keep: Keep) -> Result<Vec<u8>, String> {
 
 #[test]
 fn zstd_chunks_keep_and_skip_exactly_what_the_stream_does() {
-    let (a, b, c) = (message(1, 11, b"one"), message(2, 12, b"two!"), message(1, 13, b""));
+    let (a, b, c) = (
+        message(1, 11, b"one"),
+        message(2, 12, b"two!"),
+        message(1, 13, b""),
+    );
     let records = [a.clone(), b.clone(), c.clone()].concat();
     let n = records.len() as u64;
     let crc = crc32fast::hash(&records);
     for compression in ["zstd", ""] {
         let body = chunk(&records, compression, n, crc);
-        assert_eq!(open(&body, Keep::Whole), Ok(records.clone()), "{compression}");
+        assert_eq!(
+            open(&body, Keep::Whole),
+            Ok(records.clone()),
+            "{compression}"
+        );
         assert_eq!(open(&body, Keep::Skip), Ok([a.clone(), c.clone()].concat()));
         // the header form: opcode, length 22, the fixed fields, no payload
         let mut header = b[..9 + 22].to_vec();
