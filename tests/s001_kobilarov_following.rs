@@ -9,11 +9,14 @@
 //! The session is 12 s of the scenario's quick profile (one session) so the debug build stays
 //! fast on a 2-core CI machine; `make eval` runs the whole quick dataset.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use assert_cmd::Command;
+use common::csv;
 use peopletrack::synth::{SynthOptions, synthesize};
 
 fn root() -> PathBuf {
@@ -80,26 +83,6 @@ fn run(f: &Fixture, out: &Path, jobs: &str) -> std::process::Output {
         .arg(out)
         .output()
         .expect("runs")
-}
-
-/// Rows of a CSV table as column → value maps.
-fn csv(path: &Path) -> Vec<BTreeMap<String, String>> {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let head: Vec<String> = lines
-        .next()
-        .expect("header")
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    lines
-        .map(|l| {
-            head.iter()
-                .cloned()
-                .zip(l.split(',').map(str::to_string))
-                .collect()
-        })
-        .collect()
 }
 
 fn tables(out: &Path) -> BTreeMap<String, Vec<u8>> {

@@ -14,11 +14,14 @@
 //! person-frames, and with the calibrated box head 19 (MOTA 0.946; 0.981 over 12 s, 0.977 on
 //! the whole quick dataset).
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use assert_cmd::Command;
+use common::csv;
 use peopletrack::Nanos;
 use peopletrack::groundtruth::{PEOPLE_TOPIC, PeopleFrame};
 use peopletrack::log::msgs::{Detection2D, Detection2DArray, Header, Marker, MarkerArray};
@@ -182,26 +185,6 @@ fn run(
         .args(after)
         .output()
         .expect("runs")
-}
-
-/// Rows of a CSV table as column → value maps.
-fn csv(path: &Path) -> Vec<BTreeMap<String, String>> {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let mut lines = text.lines();
-    let head: Vec<String> = lines
-        .next()
-        .expect("header")
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    lines
-        .map(|l| {
-            head.iter()
-                .cloned()
-                .zip(l.split(',').map(str::to_string))
-                .collect()
-        })
-        .collect()
 }
 
 fn tables(out: &Path) -> BTreeMap<String, Vec<u8>> {

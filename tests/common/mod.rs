@@ -1,7 +1,8 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 /// `../shared/real/<rel>` beside the project, or `None` (with a clear message on stderr) when
 /// that folder is absent. The real data is read in place, never copied into the project.
@@ -25,3 +26,23 @@ pub fn laser_log(name: &str) -> Option<PathBuf> {
 }
 
 pub mod raw_mcap;
+
+/// Rows of a CSV table as column → value maps (naive split: for tables without quoted commas).
+pub fn csv(path: &Path) -> Vec<BTreeMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let head: Vec<String> = lines
+        .next()
+        .expect("header")
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    lines
+        .map(|l| {
+            head.iter()
+                .cloned()
+                .zip(l.split(',').map(str::to_string))
+                .collect()
+        })
+        .collect()
+}
