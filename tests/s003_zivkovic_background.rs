@@ -86,6 +86,11 @@ min_area_px = 20
 
 [params.wallflower]
 dir = "{wallflower}"
+
+[params.reid]
+datasets = ["walk"]
+clips = [{{ name = "clip", until_s = 10.0 }}, {{ name = "all" }}]
+snapshot_window_s = 1.0
 "#
     )
 }
@@ -175,6 +180,10 @@ fn pipeline_end_to_end_on_a_tiny_scene() {
         "figures/colour_overlap_walk_walk_00.png",
         "figures/colour_iterations_walk_walk_00.png",
         "figures/colour_overlay_walk_walk_00.png",
+        "tables/reid.csv",
+        "figures/reid_timeline.png",
+        "figures/reid_fig5_frames.png",
+        "figures/reid_fig6_frames.png",
     ] {
         assert!(a.contains_key(name), "{name} missing; have {:?}", a.keys());
     }

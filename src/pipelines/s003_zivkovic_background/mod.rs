@@ -43,6 +43,7 @@ mod params;
 mod reid;
 mod reid_figures;
 mod reid_report;
+mod reid_snapshots;
 mod roc;
 mod session;
 mod shared;
@@ -123,6 +124,7 @@ impl Experiment for BackgroundTracking {
         local_tracks::products(ctx, p, &mut products)?;
         reid_report::products(ctx, p, &mut products)?;
         reid_figures::products(ctx, &p.reid, &mut products)?;
+        reid_snapshots::products(ctx, &p.reid, &mut products)?;
         wallflower::products(p, &mut products)?;
         Ok(products)
     }

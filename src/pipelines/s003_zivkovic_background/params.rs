@@ -161,6 +161,9 @@ pub struct ReidParams {
     pub clips: Vec<ClipParams>,
     /// Confidence level of the t-tests.
     pub level: f64,
+    /// Figs. 5–6: the session keeps the frame with the most people of every window this long
+    /// (s); the figures draw four of them per clip.
+    pub snapshot_window_s: f64,
 }
 
 impl Default for ReidParams {
@@ -182,6 +185,7 @@ impl Default for ReidParams {
                 },
             ],
             level: 0.95,
+            snapshot_window_s: 5.0,
         }
     }
 }

@@ -20,6 +20,7 @@ use image::RgbImage;
 
 use super::local_tracks::TrackRow;
 use super::params::Params;
+use super::reid_snapshots::Snapshots;
 use super::shared::Frame;
 use crate::geometry::rect;
 use crate::report::rows::Rows;
@@ -150,6 +151,7 @@ pub(super) struct ReidRun {
     min_visibility: f64,
     min_iou: f64,
     rows: Vec<ReidFrameRow>,
+    snapshots: Snapshots,
 }
 
 impl ReidRun {
@@ -161,6 +163,7 @@ impl ReidRun {
             min_visibility: p.reid.min_visibility,
             min_iou: p.local_eval.min_iou,
             rows: Vec::new(),
+            snapshots: Snapshots::new(p.reid.snapshot_window_s),
         }
     }
 
@@ -181,8 +184,10 @@ impl ReidRun {
                 }
             }
         }
+        let mut shown: Vec<(&str, i64, [f64; 4])> = Vec::new();
         for &(id, b) in &truth_boxes {
             self.push(f, "truth", id, None, b, means);
+            shown.push(("truth", id, b));
         }
         for t in tracks {
             let b = [t.x0, t.y0, t.x1, t.y1];
@@ -193,7 +198,9 @@ impl ReidRun {
                 .max_by(|a, b| a.1.total_cmp(&b.1))
                 .map(|(id, _)| id);
             self.push(f, "system", t.track, truth_id, b, means);
+            shown.push(("system", t.track, b));
         }
+        self.snapshots.offer(f.index, f.t_s, f.rgb, &shown);
     }
 
     fn push(
@@ -218,6 +225,7 @@ impl ReidRun {
     pub fn finish(self, out: &mut SessionTables) -> anyhow::Result<()> {
         if self.wanted {
             out.insert(FRAMES_TABLE.into(), ReidFrameRow::frame(&self.rows)?);
+            self.snapshots.finish(out)?;
         }
         Ok(())
     }

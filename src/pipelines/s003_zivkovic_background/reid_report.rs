@@ -276,7 +276,7 @@ fn retrieval_rows(head: [&str; 4], obs: &[&Observation]) -> Vec<RetrievalRow> {
         .collect()
 }
 
-fn in_clip(o: &Observation, c: &ClipParams) -> bool {
+pub(super) fn in_clip(o: &Observation, c: &ClipParams) -> bool {
     c.until_s.is_none_or(|t| o.span.leave <= t)
 }
 
