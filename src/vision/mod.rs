@@ -46,6 +46,7 @@ pub mod gmm;
 pub mod jabri;
 pub mod klt;
 pub mod local;
+pub mod moving;
 pub mod omni;
 pub mod score;
 pub mod skin;

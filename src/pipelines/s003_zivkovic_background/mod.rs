@@ -39,6 +39,7 @@ mod colour;
 mod colour_report;
 mod components;
 mod local_tracks;
+mod moving;
 mod params;
 mod reid;
 mod reid_figures;
@@ -122,6 +123,7 @@ impl Experiment for BackgroundTracking {
         components::products(ctx, &mut products)?;
         colour_report::products(ctx, p, &mut products)?;
         local_tracks::products(ctx, p, &mut products)?;
+        moving::products(ctx, p, &mut products)?;
         reid_report::products(ctx, p, &mut products)?;
         reid_figures::products(ctx, &p.reid, &mut products)?;
         reid_snapshots::products(ctx, &p.reid, &mut products)?;

@@ -11,6 +11,7 @@ use crate::vision::GmmParams;
 use crate::vision::colortrack::{ColorSpace, ColorTrackError, EmParams, MeanShiftParams};
 use crate::vision::gmm::GmmError;
 use crate::vision::local::{LocalError, LocalParams};
+use crate::vision::moving::MovingParams;
 
 /// `[params.roc]`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -190,6 +191,57 @@ impl Default for ReidParams {
     }
 }
 
+/// `[params.moving]`: the moving-camera detection of Zajdel et al. §III-B (KLT corners, a
+/// RANSAC fundamental matrix, the outliers as moving people), scored on the frames where the
+/// camera moves. See `vision::moving` for what each value means.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MovingDetectParams {
+    /// The paper's 100 corner-like points.
+    pub corners: usize,
+    pub min_distance_px: f32,
+    pub ransac_threshold_px: f64,
+    pub ransac_iterations: usize,
+    pub min_points: usize,
+    pub cluster_px: f64,
+    pub gate_sigma: f64,
+    /// An object's box spans ± this many standard deviations of its points (√3: the extent
+    /// of a uniform spread).
+    pub box_sigma: f64,
+}
+
+impl Default for MovingDetectParams {
+    fn default() -> Self {
+        let d = MovingParams::default();
+        Self {
+            corners: d.corners,
+            min_distance_px: d.min_distance_px,
+            ransac_threshold_px: d.ransac_threshold_px,
+            ransac_iterations: d.ransac_iterations,
+            min_points: d.min_points,
+            cluster_px: d.cluster_px,
+            gate_sigma: d.gate_sigma,
+            box_sigma: 3f64.sqrt(),
+        }
+    }
+}
+
+impl MovingDetectParams {
+    /// The detector's settings.
+    pub fn detector(&self) -> MovingParams {
+        MovingParams {
+            corners: self.corners,
+            min_distance_px: self.min_distance_px,
+            ransac_threshold_px: self.ransac_threshold_px,
+            ransac_iterations: self.ransac_iterations,
+            min_points: self.min_points,
+            cluster_px: self.cluster_px,
+            gate_sigma: self.gate_sigma,
+            ..MovingParams::default()
+        }
+    }
+}
+
 /// `[params]` of `pipelines/s003_zivkovic_background.toml`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -202,6 +254,7 @@ pub struct Params {
     pub local_eval: LocalEvalParams,
     pub wallflower: WallflowerParams,
     pub reid: ReidParams,
+    pub moving: MovingDetectParams,
 }
 
 impl Default for Params {
@@ -214,6 +267,7 @@ impl Default for Params {
             local_eval: LocalEvalParams::default(),
             wallflower: WallflowerParams::default(),
             reid: ReidParams::default(),
+            moving: MovingDetectParams::default(),
         }
     }
 }
@@ -312,6 +366,29 @@ fn validate_reid(r: &ReidParams, bad: &mut impl FnMut(&str, String)) {
     }
 }
 
+fn validate_moving(m: &MovingDetectParams, bad: &mut impl FnMut(&str, String)) {
+    for (key, v) in [
+        ("moving.min_distance_px", f64::from(m.min_distance_px)),
+        ("moving.ransac_threshold_px", m.ransac_threshold_px),
+        ("moving.cluster_px", m.cluster_px),
+        ("moving.gate_sigma", m.gate_sigma),
+        ("moving.box_sigma", m.box_sigma),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            bad(key, format!("{v} must be finite and positive"));
+        }
+    }
+    for (key, v) in [
+        ("moving.corners", m.corners),
+        ("moving.ransac_iterations", m.ransac_iterations),
+        ("moving.min_points", m.min_points),
+    ] {
+        if v == 0 {
+            bad(key, "must be at least 1".into());
+        }
+    }
+}
+
 pub(super) fn validate(p: &Params) -> Vec<Invalid> {
     let mut out: Vec<Invalid> = Vec::new();
     let mut bad = |k: &str, r: String| out.push((k.to_string(), r));
@@ -385,6 +462,7 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
         }
     }
     validate_reid(&p.reid, &mut bad);
+    validate_moving(&p.moving, &mut bad);
     if p.roc.fp_at_pct.iter().any(|v| !(0.0..=100.0).contains(v)) {
         bad(
             "roc.fp_at_pct",
@@ -436,6 +514,11 @@ mod tests {
         assert!(validate(&p).iter().any(|(n, _)| n == "local.em.beta"));
         p.local.em.beta = 1.1;
         assert!(validate(&p).iter().any(|(n, _)| n == "local.gate_sigma"));
+        let mut m = Params::default();
+        m.moving.corners = 0;
+        m.moving.ransac_threshold_px = f64::INFINITY;
+        let names: Vec<String> = validate(&m).into_iter().map(|(n, _)| n).collect();
+        assert_eq!(names, ["moving.ransac_threshold_px", "moving.corners"]);
     }
 
     #[test]

@@ -10,6 +10,7 @@ use image::RgbImage;
 
 use super::colour::ColourRun;
 use super::local_tracks::LocalRun;
+use super::moving::MovingRun;
 use super::params::{LocalEvalParams, Params, topics_of};
 use super::reid::ReidRun;
 use super::roc::RocRun;
@@ -97,6 +98,7 @@ pub(super) fn process(
     let mut colour = ColourRun::new(p, colour_wanted);
     let mut local = LocalRun::new(p)?;
     let mut reid = ReidRun::new(p, &s.info.dataset);
+    let mut moving = MovingRun::new(p, &p.moving, cx.camera_rides_robot);
     let mut first_stamp: Option<Nanos> = None;
     let mut frame_index: i64 = -1;
     let mut shape = (0u32, 0u32);
@@ -141,6 +143,7 @@ pub(super) fn process(
         colour.step(&frame)?;
         local.step(&frame)?;
         reid.step(&frame, local.frame_tracks(frame.index));
+        moving.step(&frame);
         last_rgb = Some(f.rgb);
     }
     let frames_without_mask = frames.frames_without_mask() as i64;
@@ -185,6 +188,7 @@ pub(super) fn process(
     colour.finish(&mut out)?;
     local.finish(!cx.ground_truth.is_empty(), &mut row, &mut out)?;
     reid.finish(&mut out)?;
+    moving.finish(&s.info.dataset, &s.info.name, &mut out)?;
     out.insert(SESSION_TABLE.into(), SessionRow::frame(&[row])?);
     Ok(out)
 }
