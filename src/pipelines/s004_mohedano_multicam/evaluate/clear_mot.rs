@@ -72,7 +72,7 @@ pub(super) fn table(s: &Scored, p: &Params) -> anyhow::Result<Table> {
             }
         }
     }
-    Ok(Table::new(
+    let table = Table::new(
         "clear_mot",
         format!(
             "CLEAR MOT, IDF1 and HOTA on the ground plane ({} selection, N_app = {}, N_dis = {})",
@@ -83,7 +83,13 @@ pub(super) fn table(s: &Scored, p: &Params) -> anyhow::Result<Table> {
     .with_precision("match_m", 1)
     .with_note("Ground truth: every person inside the room at every frame (also those seen by fewer than two cameras, which no triangulation can place). A hypothesis matches a person within match_m on the ground (motmetrics 'euc' rule); MOTP is the mean matched distance in metres.")
     .with_note("Paper: no CLEAR MOT, IDF1 or error numbers are given (§6 reports figures 5–6 and qualitative statements only), hence '—'.")
-    .with_note(format!("Detectors: `{TEMPLATES}` = the paper's chain (Gabor background, templates, graph-matching 2-D tracks); `{GT_BOXES}` = the ground-truth visible boxes of the log through the same 2-D and 3-D stages (head: the box's top row on the image of the person's vertical, from the calibration; the top centre with box_head_on_axis = false); `log` = Detection2DArray topics.")))
+    .with_note(format!("Detectors: `{TEMPLATES}` = the paper's chain (Gabor background, templates, graph-matching 2-D tracks); `{GT_BOXES}` = the ground-truth visible boxes of the log through the same 2-D and 3-D stages (head: the box's top row on the image of the person's vertical, from the calibration; the top centre with box_head_on_axis = false); `log` = Detection2DArray topics."));
+    let note = super::bootstrap_note(p);
+    Ok(if note.is_empty() {
+        table
+    } else {
+        table.with_note(note)
+    })
 }
 
 #[cfg(test)]

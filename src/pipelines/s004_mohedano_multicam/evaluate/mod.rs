@@ -52,11 +52,33 @@ pub(crate) fn evaluate(s: &Scored, p: &Params, products: &mut Products) -> anyho
     }
     products.tables.push(stages::table(s)?);
     if let Some(t) = detections_2d::table(s, &mut products.summary)? {
-        products.tables.push(t);
+        let note = bootstrap_note(p);
+        products.tables.push(if note.is_empty() {
+            t
+        } else {
+            t.with_note(note)
+        });
     }
     products.tables.push(search::table(s)?);
     products.tables.push(timing::table(s)?);
     Ok(())
+}
+
+/// What the image chain's background starts from, said in the tables it affects: the default
+/// median over frames spread across the whole log uses frames later than those it is applied
+/// to (the paper does not say how its background starts).
+/// Empty when the detections come from the log (no background).
+fn bootstrap_note(p: &Params) -> String {
+    if p.detector != super::params::Detector::Templates {
+        String::new()
+    } else if p.bootstrap_frames == 0 {
+        "Background (template chain): started from the first frame alone and updated by eq. 2 (a causal start: no frame later than the one processed is used).".to_string()
+    } else {
+        format!(
+            "Background (template chain): started from the per-pixel median of {} frames spread evenly over the whole log, so it uses frames later than those it is applied to (not causal); bootstrap_frames = 0 starts from the first frame alone (causal).",
+            p.bootstrap_frames
+        )
+    }
 }
 
 fn mean(v: &[f64]) -> Option<f64> {
