@@ -20,6 +20,11 @@
 //!   in [τ, 1], colour distortion within `varThreshold`: Prati et al., OpenCV's
 //!   `detectShadowGMM`) is a shadow.
 //!
+//! **Selective learning** ([`AdaptiveGmm::apply_selective`]): a per-pixel update mask; a
+//! pixel left out keeps its mixture exactly (used by `vision::local` for the careful restart
+//! after the camera stops). Its mask is still written; with every pixel learning it is
+//! [`AdaptiveGmm::apply`] bit for bit.
+//!
 //! Mask values: [`BACKGROUND`] 0, shadow [`GmmParams::shadow_value`] (127), [`FOREGROUND`] 255.
 //! The learning rate follows OpenCV: `α = 1/min(2n, history)` on frame n unless the caller
 //! gives one (and the first frame always uses 1/2).
