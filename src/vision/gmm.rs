@@ -20,6 +20,11 @@
 //!   in [τ, 1], colour distortion within `varThreshold`: Prati et al., OpenCV's
 //!   `detectShadowGMM`) is a shadow.
 //!
+//! **Selective learning** ([`AdaptiveGmm::apply_selective`]): a per-pixel update mask; a
+//! pixel left out keeps its mixture exactly (used by `vision::local` for the careful restart
+//! after the camera stops). Its mask is still written; with every pixel learning it is
+//! [`AdaptiveGmm::apply`] bit for bit.
+//!
 //! Mask values: [`BACKGROUND`] 0, shadow [`GmmParams::shadow_value`] (127), [`FOREGROUND`] 255.
 //! The learning rate follows OpenCV: `α = 1/min(2n, history)` on frame n unless the caller
 //! gives one (and the first frame always uses 1/2).
@@ -111,6 +116,8 @@ pub enum GmmError {
     UnsupportedChannels { channels: usize },
     #[error("mask has {have} bytes, the frame has {need} pixels")]
     MaskSize { have: usize, need: usize },
+    #[error("update mask has {have} flags, the frame has {need} pixels")]
+    UpdateMaskSize { have: usize, need: usize },
     #[error(
         "frame is {width}x{height}x{channels} but the model holds {model_width}x{model_height}x{model_channels} (call reset to start over)"
     )]
@@ -341,15 +348,44 @@ impl AdaptiveGmm {
         learning_rate: Option<f32>,
         mask: &mut [u8],
     ) -> Result<(), GmmError> {
-        self.apply_with(Isa::detect(), frame, learning_rate, mask)
+        self.apply_with(Isa::detect(), frame, learning_rate, None, mask)
     }
 
-    /// [`Self::apply`] on a given instruction set (the tests run every one available).
+    /// [`Self::apply`] with selective learning: only the pixels whose `learn` flag is set
+    /// (one per pixel, row-major) update their mixture; a frozen pixel's model stays exactly
+    /// as it was (no weight decays, no component is created or dropped — before its first
+    /// update it has no component at all). Every pixel's mask is what [`Self::apply`] would
+    /// write for this frame, and the learning-rate schedule counts the frame for all pixels.
+    /// With every flag set the result is bit for bit that of [`Self::apply`].
+    ///
+    /// This is the careful restart of Zajdel et al. (ICRA 2005, §III-A): "the objects that
+    /// were tracked during the moving phase might stay still and occlude a part of the
+    /// background. This part of the background is learned only when the objects … leave".
+    pub fn apply_selective(
+        &mut self,
+        frame: ImageView<'_>,
+        learning_rate: Option<f32>,
+        learn: &[bool],
+        mask: &mut [u8],
+    ) -> Result<(), GmmError> {
+        if learn.len() != frame.pixels() {
+            return Err(GmmError::UpdateMaskSize {
+                have: learn.len(),
+                need: frame.pixels(),
+            });
+        }
+        let learn = (!learn.iter().all(|&l| l)).then_some(learn);
+        self.apply_with(Isa::detect(), frame, learning_rate, learn, mask)
+    }
+
+    /// [`Self::apply`] / [`Self::apply_selective`] on a given instruction set (the tests run
+    /// every one available); `learn` has been checked to hold one flag per pixel.
     fn apply_with(
         &mut self,
         isa: Isa,
         frame: ImageView<'_>,
         learning_rate: Option<f32>,
+        learn: Option<&[bool]>,
         mask: &mut [u8],
     ) -> Result<(), GmmError> {
         let shape = Shape {
@@ -402,8 +438,10 @@ impl AdaptiveGmm {
             .zip(self.modes.par_chunks_mut(groups))
             .zip(frame.data().par_chunks(row_bytes))
             .zip(mask.par_chunks_mut(shape.width))
-            .for_each(|(((state, modes), pixels), mask)| {
-                kernel::update_row(isa, shape.channels, state, modes, pixels, mask, &co);
+            .enumerate()
+            .for_each(|(y, (((state, modes), pixels), mask))| {
+                let learn = learn.map(|l| &l[y * shape.width..(y + 1) * shape.width]);
+                kernel::update_row(isa, shape.channels, state, modes, pixels, mask, learn, &co);
             });
         Ok(())
     }

@@ -29,15 +29,30 @@
 //!    a moving camera, nor a person who stays still for long, the colour tracker can):
 //!    - when the camera starts moving, every blob track is handed over; the GMM is not
 //!      updated while the camera moves and restarts from scratch when it stops, with no blobs
-//!      for `warmup_frames` (section III-A: "background estimation should be started
-//!      carefully");
+//!      for `warmup_frames`, and *carefully* (section III-A: "the objects that were tracked
+//!      during the moving phase might stay still and occlude a part of the background. This
+//!      part of the background is learned only when the objects … leave"): every track that
+//!      is colour-tracked when the camera stops is *protected* — the pixels of its body box
+//!      (the √3σ box of the blob ellipse it was handed over with, times `protect_scale`,
+//!      centred where the track is) do not update the model
+//!      ([`AdaptiveGmm::apply_selective`]) until the track ends, or at most `protect_frames`
+//!      frames (the paper's 220: by then a static object would have joined the background
+//!      anyway). A pixel that has no model yet (frozen since the restart) is not foreground;
+//!      it is learned from the first frame it is no longer covered;
 //!    - when a track that has travelled at least `min_travel_px` from where it started has
 //!      moved its centroid less than `still_speed_px` per frame over the last `still_frames`
 //!      frames (the person stands still and will fade into the background). A track that
 //!      never moved (a ghost, a moved chair) is never handed over: it ends with its blob.
 //!
 //!    The colour model is the kernel-weighted histogram (eq. 17) of the track's last blob
-//!    ellipse, refreshed every frame the track is seen as a blob.
+//!    ellipse, refreshed every frame the track is seen as a blob. Section III-C: the search
+//!    starts from the previous region "but we also try some random initializations to find
+//!    global maximum": besides the previous region, `random_starts` regions of the same shape
+//!    shifted by a uniform draw within ±`random_start_sigma` σ per axis (a hash of the track,
+//!    the frame and the draw: deterministic) are tracked too, and the one with the largest
+//!    Bhattacharyya coefficient wins (the previous region on ties). How many, and how far,
+//!    the paper does not say; these are ours. Off by default (`random_starts = 0`): on the
+//!    quick `home_tour` log they kept colour tracks alive on background (see the README).
 //! 5. A blob track missed more than `max_missed` frames in a row ends.
 //!
 //! Each [`Observation`] names its track, the mode, the ellipse and box, and (in blob mode)
@@ -45,8 +60,8 @@
 //! the exact pixels (re-identification's colour features).
 //!
 //! Whether the camera moves is the caller's input (from odometry in the pipelines). Not here:
-//! the optic-flow detector of the paper (moving camera), random restarts of the colour
-//! tracker, splitting merged people, occlusion reasoning, selective background learning.
+//! the optic-flow detector of the paper (moving camera), splitting merged people, occlusion
+//! reasoning.
 
 use std::collections::VecDeque;
 
@@ -125,6 +140,15 @@ pub struct LocalParams {
     pub reacquire_overlap: f64,
     /// A track that stood still is taken back by a blob only this far from where it stopped (px).
     pub resume_px: f64,
+    /// After a restart, a colour-tracked track's body box (the √3σ box of its hand-over blob
+    /// ellipse) times this is not learned while the track lives.
+    pub protect_scale: f64,
+    /// Frames after a restart at most during which protected boxes are not learned.
+    pub protect_frames: u32,
+    /// Random initialisations of the colour tracker per frame, besides the previous region.
+    pub random_starts: u32,
+    /// They are shifted uniformly within ± this many σ of the region, per axis.
+    pub random_start_sigma: f64,
 }
 
 impl Default for LocalParams {
@@ -151,6 +175,10 @@ impl Default for LocalParams {
             min_similarity: 0.6,
             reacquire_overlap: 0.3,
             resume_px: 8.0,
+            protect_scale: 2.0,
+            protect_frames: 220,
+            random_starts: 0,
+            random_start_sigma: 1.0,
         }
     }
 }
@@ -165,6 +193,8 @@ impl LocalParams {
             ("still_speed_px", self.still_speed_px),
             ("min_travel_px", self.min_travel_px),
             ("resume_px", self.resume_px),
+            ("protect_scale", self.protect_scale),
+            ("random_start_sigma", self.random_start_sigma),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(name, v, "must be finite and non-negative");
@@ -243,6 +273,10 @@ struct Track {
     recent: VecDeque<Point2<f64>>,
     missed: u32,
     anchor: Option<Point2<f64>>,
+    /// The blob ellipse the track was last handed over to the colour tracker with.
+    body: Option<Ellipse>,
+    /// Its body box is not learned (set at a restart of the background model).
+    protected: bool,
     ended: bool,
     /// This frame's observation, if any.
     seen: Option<Observation>,
@@ -258,6 +292,8 @@ pub struct LocalStats {
     pub handovers_camera: u64,
     pub handovers_still: u64,
     pub reacquired: u64,
+    /// Frames on which some pixels were not learned (protected boxes after a restart).
+    pub protected_frames: u64,
 }
 
 /// The local tracker of one camera.
@@ -274,6 +310,10 @@ pub struct LocalTracker {
     next_id: u32,
     moving: bool,
     since_reset: u32,
+    /// Per pixel: may the model learn it this frame (see the module doc, hand-over).
+    learn: Vec<bool>,
+    /// Some pixels may have no model (they were frozen since the restart).
+    unmodelled: bool,
     observations: Vec<Observation>,
     stats: LocalStats,
 }
@@ -293,6 +333,8 @@ impl LocalTracker {
             next_id: 1,
             moving: false,
             since_reset: 0,
+            learn: Vec::new(),
+            unmodelled: false,
             observations: Vec::new(),
             stats: LocalStats::default(),
         })
@@ -336,6 +378,7 @@ impl LocalTracker {
                 self.mask = vec![0; w * h];
                 self.filtered = vec![0; w * h];
                 self.labels = vec![0; w * h];
+                self.learn = vec![true; w * h];
             }
             Some((hw, hh)) if (hw, hh) != (w, h) => {
                 return Err(LocalError::FrameSize {
@@ -377,6 +420,7 @@ impl LocalTracker {
                         if t.model.is_some() {
                             t.mode = Mode::Colour(HandOver::CameraMoving);
                             t.anchor = None;
+                            t.body = Some(t.region);
                             self.stats.handovers_camera += 1;
                         } else {
                             t.ended = true;
@@ -395,8 +439,11 @@ impl LocalTracker {
             self.since_reset = 0;
             self.stats.gmm_restarts += 1;
             self.moving = false;
+            for t in &mut self.tracks {
+                t.protected = matches!(t.mode, Mode::Colour(_)) && t.body.is_some();
+            }
         }
-        self.gmm.apply(frame, None, &mut self.mask)?;
+        self.learn_selectively(frame)?;
         self.since_reset = self.since_reset.saturating_add(1);
         if self.since_reset <= self.params.warmup_frames {
             self.labels.fill(0);
@@ -423,9 +470,11 @@ impl LocalTracker {
         Ok(())
     }
 
-    /// Move the colour-tracked tracks with the EM-like tracker.
+    /// Move the colour-tracked tracks with the EM-like tracker, from the previous region and
+    /// from `random_starts` random shifts of it (section III-C); the most similar result wins.
     fn colour_step(&mut self, bins: &BinImage) -> Result<(), LocalError> {
         let (w, h) = (bins.width() as f64, bins.height() as f64);
+        let p = self.params;
         for t in &mut self.tracks {
             let Mode::Colour(_) = t.mode else {
                 continue;
@@ -434,7 +483,14 @@ impl LocalTracker {
                 t.ended = true;
                 continue;
             };
-            let r = em_like(bins, model, &t.region, &self.params.em)?;
+            let mut r = em_like(bins, model, &t.region, &p.em)?;
+            for k in 0..p.random_starts {
+                let start = careful::random_start(&t.region, t.id, self.stats.frames, k, &p);
+                let other = em_like(bins, model, &start, &p.em)?;
+                if !other.lost && (r.lost || other.similarity > r.similarity) {
+                    r = other;
+                }
+            }
             let c = r.region.center;
             let inside = c.x >= 0.0 && c.y >= 0.0 && c.x < w && c.y < h;
             if r.lost || !inside || r.similarity < self.params.min_similarity {
@@ -625,6 +681,7 @@ impl LocalTracker {
             {
                 t.mode = Mode::Colour(HandOver::StandingStill);
                 t.anchor = Some(*last);
+                t.body = Some(region);
                 self.stats.handovers_still += 1;
             }
         }
@@ -660,6 +717,8 @@ impl LocalTracker {
                 recent,
                 missed: 0,
                 anchor: None,
+                body: None,
+                protected: false,
                 ended: false,
                 seen: Some(Observation {
                     track: id,
@@ -681,5 +740,6 @@ impl LocalTracker {
     }
 }
 
+mod careful;
 #[cfg(test)]
 mod tests;

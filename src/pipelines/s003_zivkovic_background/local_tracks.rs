@@ -305,8 +305,8 @@ pub(super) fn products(ctx: &Aggregate, p: &Params, products: &mut Products) -> 
             p.local_eval.min_iou, p.local_eval.min_visibility
         ))
         .with_note(format!(
-            "The camera is taken as moving when odometry reports more than {} m/s or {} rad/s and TF hangs the camera frame below the odometry's robot frame (a camera fixed in the world never moves); then the background model is paused and restarted ({} warm-up frames without blobs) when the camera stops.",
-            p.local_eval.moving_speed_mps, p.local_eval.moving_turn_rad_s, p.local.warmup_frames
+            "The camera is taken as moving when odometry reports more than {} m/s or {} rad/s (mean twist over the last {} s of samples) and TF hangs the camera frame below the odometry's robot frame (a camera fixed in the world never moves); then the background model is paused and restarted ({} warm-up frames without blobs) when the camera stops, not learning the body boxes of the people tracked through the motion until they leave (at most {} frames).",
+            p.local_eval.moving_speed_mps, p.local_eval.moving_turn_rad_s, p.local_eval.moving_window_s, p.local.warmup_frames, p.local.protect_frames
         ))
         .with_note("No paper values: Zajdel et al. (ICRA 2005) evaluate identities across local tracks, not the local tracks themselves."),
     );

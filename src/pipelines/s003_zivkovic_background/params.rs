@@ -100,8 +100,11 @@ pub struct LocalEvalParams {
     pub min_visibility: f64,
     /// The camera moves when odometry reports more than this speed (m/s) ...
     pub moving_speed_mps: f64,
-    /// ... or turn rate (rad/s).
+    /// ... or turn rate (rad/s), averaged over the odometry samples of the last
+    /// `moving_window_s` seconds before the frame (a single sample's noise is no motion).
     pub moving_turn_rad_s: f64,
+    /// Averaging window of the odometry twist (s); 0 = the nearest sample alone.
+    pub moving_window_s: f64,
 }
 
 impl Default for LocalEvalParams {
@@ -111,6 +114,7 @@ impl Default for LocalEvalParams {
             min_visibility: 0.3,
             moving_speed_mps: 0.02,
             moving_turn_rad_s: 0.02,
+            moving_window_s: 0.3,
         }
     }
 }
@@ -456,6 +460,7 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
             "local_eval.moving_turn_rad_s",
             p.local_eval.moving_turn_rad_s,
         ),
+        ("local_eval.moving_window_s", p.local_eval.moving_window_s),
     ] {
         if !(v.is_finite() && v >= 0.0) {
             bad(key, format!("{v} must be finite and non-negative"));

@@ -387,7 +387,9 @@ fn detect_shadow<S: Simd, const C: usize>(
 
 /// Update one image row: `state` is the row's [`Layout::row_len`] lane vectors, `modes` one
 /// `[u8; LANES]` per group, `frame` the row's `width * C` bytes and `mask` its `width`
-/// output bytes.
+/// output bytes. `learn`, when given (`width` flags), names the pixels whose model may
+/// change: a group with a frozen pixel is updated as usual, then its frozen lanes get their
+/// saved mixture back (see [`Frozen`]).
 #[inline(always)]
 fn update_row_generic<S: Simd, const C: usize>(
     s: S,
@@ -395,6 +397,7 @@ fn update_row_generic<S: Simd, const C: usize>(
     modes: &mut [[u8; LANES]],
     frame: &[u8],
     mask: &mut [u8],
+    learn: Option<&[bool]>,
     co: &Coeffs,
 ) {
     let width = mask.len();
@@ -415,8 +418,69 @@ fn update_row_generic<S: Simd, const C: usize>(
             padded[..n * C].copy_from_slice(&frame[x0 * C..(x0 + n) * C]);
             s.load_pixels::<C>(&padded)
         };
+        let frozen = learn.map_or(0, |l| frozen_bits(&l[x0..x0 + n]));
+        let saved = (frozen != 0).then(|| Frozen::save(&grp, modes));
         let out = update_group::<S, C>(s, &mut grp, modes, &x, co);
+        if let Some(saved) = saved {
+            saved.restore(&mut grp, modes, frozen);
+        }
         mask[x0..x0 + n].copy_from_slice(&out[..n]);
+    }
+}
+
+/// Bit `l` set where pixel `l` of a group must not learn.
+#[inline(always)]
+fn frozen_bits(learn: &[bool]) -> u32 {
+    let mut bits = 0;
+    for (l, &ok) in learn.iter().enumerate() {
+        if !ok {
+            bits |= 1 << l;
+        }
+    }
+    bits
+}
+
+/// A group's whole mixture state (every slot, and the component counts), saved before the
+/// update so that its frozen lanes can be put back exactly: a frozen pixel's model is left
+/// bit for bit as it was (no weight decays, no component starts, none is dropped). Only
+/// groups with a frozen pixel pay for it; without an update mask nothing is copied.
+struct Frozen {
+    slots: [[f32; LANES]; MAX_SLOT_VECTORS],
+    modes: [u8; LANES],
+}
+
+/// Lane vectors per group at most: `MAX_MIXTURES` slots of `2 + 3` fields.
+const MAX_SLOT_VECTORS: usize = super::MAX_MIXTURES * 5;
+
+impl Frozen {
+    #[inline(always)]
+    fn save(grp: &Group<'_>, modes: &[u8; LANES]) -> Self {
+        let mut slots = [[0.0f32; LANES]; MAX_SLOT_VECTORS];
+        let stride = grp.layout.stride;
+        for k in 0..grp.layout.n_mix {
+            for f in 0..stride {
+                slots[k * stride + f] = grp.row[grp.at(k, f)];
+            }
+        }
+        Self {
+            slots,
+            modes: *modes,
+        }
+    }
+
+    #[inline(always)]
+    fn restore(&self, grp: &mut Group<'_>, modes: &mut [u8; LANES], mut bits: u32) {
+        let stride = grp.layout.stride;
+        while bits != 0 {
+            let l = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            for k in 0..grp.layout.n_mix {
+                for f in 0..stride {
+                    *grp.lane(k, f, l) = self.slots[k * stride + f][l];
+                }
+            }
+            modes[l] = self.modes[l];
+        }
     }
 }
 
@@ -452,6 +516,7 @@ impl Isa {
 /// The generic row compiled with AVX2 enabled, so the intrinsics inline.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
+#[allow(clippy::too_many_arguments)]
 fn update_row_avx2(
     s: avx2::Avx2,
     channels: usize,
@@ -459,16 +524,19 @@ fn update_row_avx2(
     modes: &mut [[u8; LANES]],
     frame: &[u8],
     mask: &mut [u8],
+    learn: Option<&[bool]>,
     co: &Coeffs,
 ) {
     if channels == 1 {
-        update_row_generic::<_, 1>(s, state, modes, frame, mask, co)
+        update_row_generic::<_, 1>(s, state, modes, frame, mask, learn, co)
     } else {
-        update_row_generic::<_, 3>(s, state, modes, frame, mask, co)
+        update_row_generic::<_, 3>(s, state, modes, frame, mask, learn, co)
     }
 }
 
-/// Update one row with `channels` (1 or 3) interleaved channels.
+/// Update one row with `channels` (1 or 3) interleaved channels; `learn` as in
+/// `update_row_generic`.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn update_row(
     isa: Isa,
     channels: usize,
@@ -476,15 +544,18 @@ pub(super) fn update_row(
     modes: &mut [[u8; LANES]],
     frame: &[u8],
     mask: &mut [u8],
+    learn: Option<&[bool]>,
     co: &Coeffs,
 ) {
     match isa {
         Isa::Portable if channels == 1 => {
-            update_row_generic::<_, 1>(Portable, state, modes, frame, mask, co)
+            update_row_generic::<_, 1>(Portable, state, modes, frame, mask, learn, co)
         }
-        Isa::Portable => update_row_generic::<_, 3>(Portable, state, modes, frame, mask, co),
+        Isa::Portable => update_row_generic::<_, 3>(Portable, state, modes, frame, mask, learn, co),
         #[cfg(target_arch = "x86_64")]
         // SAFETY: an `Avx2` token exists only after AVX2 was detected on this CPU.
-        Isa::Avx2(a) => unsafe { update_row_avx2(a, channels, state, modes, frame, mask, co) },
+        Isa::Avx2(a) => unsafe {
+            update_row_avx2(a, channels, state, modes, frame, mask, learn, co)
+        },
     }
 }

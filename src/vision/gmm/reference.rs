@@ -36,6 +36,18 @@ impl ReferenceGmm {
     }
 
     pub fn apply(&mut self, frame: &[u8], learning_rate: Option<f32>, mask: &mut [u8]) {
+        self.apply_masked(frame, learning_rate, None, mask);
+    }
+
+    /// Selective learning: a pixel whose `learn` flag is false is updated as usual for its
+    /// mask, then gets its old mixture back (the model of a frozen pixel does not change).
+    pub fn apply_masked(
+        &mut self,
+        frame: &[u8],
+        learning_rate: Option<f32>,
+        learn: Option<&[bool]>,
+        mask: &mut [u8],
+    ) {
         self.frames += 1;
         // α of eq. 4–6 and 14 (α ≈ 1/T, section 3); OpenCV's schedule 1/min(2n, history).
         let alpha = match learning_rate {
@@ -51,7 +63,13 @@ impl ReferenceGmm {
             for ch in 0..c {
                 x[ch] = f32::from(frame[p * c + ch]);
             }
+            let frozen = learn.is_some_and(|l| !l[p]);
+            let saved = frozen.then(|| (self.slots[p].clone(), self.used[p]));
             mask[p] = self.pixel(p, &x, alpha, prune);
+            if let Some((slots, used)) = saved {
+                self.slots[p] = slots;
+                self.used[p] = used;
+            }
         }
     }
 

@@ -416,7 +416,7 @@ fn kernel_matches_scalar_reference_bit_for_bit() {
             let (mut got, mut want) = (vec![0u8; w * h], vec![0u8; w * h]);
             for (t, f) in frames.iter().enumerate() {
                 let view = ImageView::new(f, w, h, c).expect("frame");
-                m.apply_with(isa, view, lr, &mut got).expect("apply");
+                m.apply_with(isa, view, lr, None, &mut got).expect("apply");
                 r.apply(f, lr, &mut want);
                 assert_eq!(got, want, "case {i} frame {t}");
                 assert_same_state(&m, &r, w, t);
@@ -495,7 +495,7 @@ fn check_against_reference(
     let (mut got, mut want) = (vec![0u8; w * h], vec![0u8; w * h]);
     for (t, f) in frames.iter().enumerate() {
         let view = ImageView::new(f, w, h, c).expect("frame");
-        pool.install(|| m.apply_with(isa, view, lr, &mut got))
+        pool.install(|| m.apply_with(isa, view, lr, None, &mut got))
             .expect("apply");
         r.apply(f, lr, &mut want);
         assert_eq!(got, want, "{w}x{h}x{c} frame {t} on {threads} threads");
@@ -610,4 +610,99 @@ fn hand_made_lanes_with_different_histories_match_reference_and_known_answers() 
     }
     // The shadow and the other hue each started a component on the last frame.
     assert_eq!(m.components_per_pixel(), [1, 2, 3, 1, 2, 2, 1, 1, 1]);
+}
+
+/// Selective learning ([`AdaptiveGmm::apply_selective`]): the kernel against the scalar
+/// reference with a random update mask (every instruction set), and known answers — a frozen
+/// pixel's mixture is exactly what it was, an unfrozen pixel's mixture and every pixel's mask
+/// are those of the unmasked run, a pixel frozen from the first frame has no component, and an
+/// all-true mask is the plain update bit for bit.
+#[test]
+fn masked_update_freezes_exactly_the_masked_pixels() {
+    let (w, h, c) = (11, 3, 3);
+    let frames = stress_frames(w, h, c, 60, 4242);
+    let params = GmmParams::default();
+    for isa in Isa::available() {
+        let mut rng = Rng(17);
+        let mut m = model(params);
+        let mut r = ReferenceGmm::new(params, w * h, c);
+        let (mut got, mut want) = (vec![0u8; w * h], vec![0u8; w * h]);
+        for (t, f) in frames.iter().enumerate() {
+            let learn: Vec<bool> = (0..w * h).map(|_| rng.below(3) != 0).collect();
+            let view = ImageView::new(f, w, h, c).expect("frame");
+            m.apply_with(isa, view, None, Some(&learn), &mut got)
+                .expect("apply");
+            r.apply_masked(f, None, Some(&learn), &mut want);
+            assert_eq!(got, want, "masked frame {t}");
+            assert_same_state(&m, &r, w, t);
+        }
+    }
+    // Known answers against the unmasked run: pixels 3 and 20 frozen on frames 10..30.
+    let frozen = |p: usize| p == 3 || p == 20;
+    let mut plain = model(params);
+    let mut sel = model(params);
+    let (mut a, mut b) = (vec![0u8; w * h], vec![0u8; w * h]);
+    let mut before: Vec<Vec<Component>> = Vec::new();
+    for (t, f) in frames.iter().enumerate() {
+        let view = ImageView::new(f, w, h, c).expect("frame");
+        let learn: Vec<bool> = (0..w * h)
+            .map(|p| !(10..30).contains(&t) || !frozen(p))
+            .collect();
+        if t == 10 {
+            before = (0..w * h)
+                .map(|p| sel.components(p % w, p / w).expect("px"))
+                .collect();
+        }
+        plain.apply(view, None, &mut a).expect("apply");
+        sel.apply_selective(view, None, &learn, &mut b)
+            .expect("apply");
+        if t <= 10 {
+            assert_eq!(
+                a, b,
+                "same masks until the first frozen frame is classified ({t})"
+            );
+        }
+        for p in 0..w * h {
+            let (x, y) = (p % w, p / w);
+            let got = sel.components(x, y).expect("px");
+            if (10..30).contains(&t) && frozen(p) {
+                assert_eq!(got, before[p], "frozen pixel {p} changed on frame {t}");
+            } else if !frozen(p) {
+                assert_eq!(
+                    got,
+                    plain.components(x, y).expect("px"),
+                    "pixel {p} frame {t}"
+                );
+                assert_eq!(a[p], b[p], "mask of pixel {p} frame {t}");
+            }
+        }
+    }
+    // A pixel frozen from the first frame has no model; an all-true mask is `apply`.
+    let mut fresh = model(params);
+    let mut all = model(params);
+    let mut mask = vec![0u8; w * h];
+    let mut learn = vec![true; w * h];
+    learn[5] = false;
+    let view = ImageView::new(&frames[0], w, h, c).expect("frame");
+    fresh
+        .apply_selective(view, None, &learn, &mut mask)
+        .expect("apply");
+    assert!(fresh.components(5, 0).expect("px").is_empty());
+    assert_eq!(fresh.components(6, 0).expect("px").len(), 1);
+    let mut plain = model(params);
+    for f in &frames {
+        let view = ImageView::new(f, w, h, c).expect("frame");
+        plain.apply(view, None, &mut a).expect("apply");
+        all.apply_selective(view, None, &vec![true; w * h], &mut b)
+            .expect("apply");
+        assert_eq!(a, b);
+    }
+    let (mut s1, mut s2) = (Vec::new(), Vec::new());
+    plain.save(&mut s1).expect("save");
+    all.save(&mut s2).expect("save");
+    assert_eq!(s1, s2);
+    assert!(matches!(
+        all.apply_selective(view, None, &[true; 4], &mut b),
+        Err(GmmError::UpdateMaskSize { have: 4, need: 33 })
+    ));
 }
