@@ -8,6 +8,8 @@
 //!
 //! - `mot/clear_identity_from_csv`: parse both files, match every frame, CLEAR MOT and IDF1
 //!   — the work py-motmetrics does (`loadtxt`, `compare_to_groundtruth`, `compute`).
+//! - `mot/clear_identity_from_csv_two_threads`: the same with the two files parsed at once
+//!   on two threads (as `peopletrack score` reads them); the rest is one thread.
 //! - `mot/all_metrics_from_csv`: the same plus HOTA.
 
 use std::collections::HashMap;
@@ -155,7 +157,20 @@ fn bench_data_dir() -> PathBuf {
 fn score_csv(gt: &str, hyp: &str, with_hota: bool) -> f64 {
     let g = parse_motchallenge(gt, Path::new("gt.txt"), GeometryKind::Box).expect("gt parses");
     let h = parse_motchallenge(hyp, Path::new("hyp.txt"), GeometryKind::Box).expect("hyp parses");
-    let seq = Sequence::new(&g, &h, RULE).expect("valid");
+    score(&g, &h, with_hota)
+}
+
+/// `score_csv` with the two files parsed at once on two threads, as `peopletrack score` does.
+fn score_csv_two_threads(gt: &str, hyp: &str) -> f64 {
+    let (g, h) = rayon::join(
+        || parse_motchallenge(gt, Path::new("gt.txt"), GeometryKind::Box).expect("gt parses"),
+        || parse_motchallenge(hyp, Path::new("hyp.txt"), GeometryKind::Box).expect("hyp parses"),
+    );
+    score(&g, &h, false)
+}
+
+fn score(g: &[Observation], h: &[Observation], with_hota: bool) -> f64 {
+    let seq = Sequence::new(g, h, RULE).expect("valid");
     let (clear, _events) = seq.clear_mot();
     let id = seq.identity();
     let hota = if with_hota { seq.hota().hota } else { 0.0 };
@@ -190,6 +205,9 @@ fn mot(c: &mut Criterion) {
     g.measurement_time(Duration::from_secs(10));
     g.bench_function("clear_identity_from_csv", |b| {
         b.iter(|| score_csv(&gt_text, &hyp_text, false))
+    });
+    g.bench_function("clear_identity_from_csv_two_threads", |b| {
+        b.iter(|| score_csv_two_threads(&gt_text, &hyp_text))
     });
     g.bench_function("all_metrics_from_csv", |b| {
         b.iter(|| score_csv(&gt_text, &hyp_text, true))

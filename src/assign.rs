@@ -38,33 +38,105 @@ pub fn min_cost_max_pairs(
             }
         }
     }
-    if allowed.is_empty() {
-        return Vec::new();
-    }
-    let (lo, hi) = allowed.iter().fold(
-        (f64::INFINITY, f64::NEG_INFINITY),
-        |(lo, hi), &(_, _, x)| (lo.min(x), hi.max(x)),
-    );
-    let size = side_size(&allowed);
-    let bits = quant_bits(size);
-    let range = hi - lo;
-    let scale = if range > 0.0 {
-        (1u64 << bits) as f64 / range
-    } else {
-        0.0
-    };
-    let max_q = 1i64 << bits;
-    // Weight = K − quantised cost with K > size · max cost: a matching with one more pair
-    // always weighs more, and among matchings of one size the cheapest weighs most.
-    let k = size as i64 * max_q + 1;
-    let edges: Vec<(usize, usize, i64)> = allowed
-        .into_iter()
-        .map(|(r, c, x)| {
+    Assigner::default()
+        .min_cost_max_pairs(rows, cols, &allowed)
+        .to_vec()
+}
+
+/// Buffers for solving many small assignments in a row (CLEAR MOT's one per frame) without
+/// allocating for each; the answers are those of the free functions.
+#[derive(Debug, Default)]
+pub struct Assigner {
+    edges: Vec<(usize, usize, i64)>,
+    keys: Vec<usize>,
+    parent: Vec<usize>,
+    by_root: Vec<(usize, usize)>,
+    component: Vec<(usize, usize, i64)>,
+    out: Vec<(usize, usize)>,
+}
+
+impl Assigner {
+    /// [`min_cost_max_pairs`] over the allowed pairs `(row, col, cost)` (every cost finite),
+    /// listed by row, then column.
+    pub fn min_cost_max_pairs(
+        &mut self,
+        rows: usize,
+        cols: usize,
+        allowed: &[(usize, usize, f64)],
+    ) -> &[(usize, usize)] {
+        self.out.clear();
+        if allowed.is_empty() {
+            return &self.out;
+        }
+        let (lo, hi) = allowed.iter().fold(
+            (f64::INFINITY, f64::NEG_INFINITY),
+            |(lo, hi), &(_, _, x)| (lo.min(x), hi.max(x)),
+        );
+        let size = side_size_with(allowed, &mut self.keys);
+        let bits = quant_bits(size);
+        let range = hi - lo;
+        let scale = if range > 0.0 {
+            (1u64 << bits) as f64 / range
+        } else {
+            0.0
+        };
+        let max_q = 1i64 << bits;
+        // Weight = K − quantised cost with K > size · max cost: a matching with one more pair
+        // always weighs more, and among matchings of one size the cheapest weighs most.
+        let k = size as i64 * max_q + 1;
+        self.edges.clear();
+        self.edges.extend(allowed.iter().map(|&(r, c, x)| {
             let q = (((x - lo) * scale).round() as i64).clamp(0, max_q);
             (r, c, k - q)
-        })
-        .collect();
-    max_weight_pairs(rows, cols, &edges)
+        }));
+        self.max_weight_pairs(rows, cols);
+        &self.out
+    }
+
+    /// Maximum-weight matching over `self.edges` (weights > 0), solved per connected
+    /// component, into `self.out` sorted by row.
+    fn max_weight_pairs(&mut self, rows: usize, cols: usize) {
+        self.out.clear();
+        if self.edges.is_empty() {
+            return;
+        }
+        // Union-find over rows (0..rows) and columns (rows..rows + cols).
+        let parent = &mut self.parent;
+        parent.clear();
+        parent.extend(0..rows + cols);
+        fn find(parent: &mut [usize], mut x: usize) -> usize {
+            while parent[x] != x {
+                parent[x] = parent[parent[x]];
+                x = parent[x];
+            }
+            x
+        }
+        for &(r, c, _) in &self.edges {
+            let a = find(parent, r);
+            let b = find(parent, rows + c);
+            if a != b {
+                parent[a] = b;
+            }
+        }
+        // Edges grouped by component, each group in edge order.
+        self.by_root.clear();
+        for (k, e) in self.edges.iter().enumerate() {
+            self.by_root.push((find(parent, e.0), k));
+        }
+        self.by_root.sort_unstable();
+        for group in self.by_root.chunk_by(|a, b| a.0 == b.0) {
+            if let [(_, k)] = group {
+                let (r, c, _) = self.edges[*k];
+                self.out.push((r, c));
+                continue;
+            }
+            self.component.clear();
+            self.component
+                .extend(group.iter().map(|&(_, k)| self.edges[k]));
+            solve_component(&self.component, &mut self.out);
+        }
+        self.out.sort_unstable();
+    }
 }
 
 /// Pairs `(row, col)` maximising the total of `score(row, col)`; pairs scoring zero or less
@@ -117,13 +189,21 @@ pub fn max_count_pairs(
 /// The number of distinct rows or columns that have an edge, whichever is smaller: an upper
 /// bound on the number of pairs in any matching.
 fn side_size<T>(edges: &[(usize, usize, T)]) -> usize {
-    let mut rs: Vec<usize> = edges.iter().map(|e| e.0).collect();
-    let mut cs: Vec<usize> = edges.iter().map(|e| e.1).collect();
-    rs.sort_unstable();
-    rs.dedup();
-    cs.sort_unstable();
-    cs.dedup();
-    rs.len().min(cs.len()).max(1)
+    side_size_with(edges, &mut Vec::new())
+}
+
+/// [`side_size`] with a caller's buffer.
+fn side_size_with<T>(edges: &[(usize, usize, T)], keys: &mut Vec<usize>) -> usize {
+    let mut distinct = |key: fn(&(usize, usize, T)) -> usize| {
+        keys.clear();
+        keys.extend(edges.iter().map(key));
+        keys.sort_unstable();
+        keys.dedup();
+        keys.len()
+    };
+    let rs = distinct(|e| e.0);
+    let cs = distinct(|e| e.1);
+    rs.min(cs).max(1)
 }
 
 /// Bits of cost resolution such that `size² · 2^bits` stays well inside `i64`.
@@ -141,41 +221,12 @@ fn max_weight_pairs(
     cols: usize,
     edges: &[(usize, usize, i64)],
 ) -> Vec<(usize, usize)> {
-    let mut out = Vec::new();
-    if edges.is_empty() {
-        return out;
-    }
-    // Union-find over rows (0..rows) and columns (rows..rows + cols).
-    let mut parent: Vec<usize> = (0..rows + cols).collect();
-    fn find(parent: &mut [usize], mut x: usize) -> usize {
-        while parent[x] != x {
-            parent[x] = parent[parent[x]];
-            x = parent[x];
-        }
-        x
-    }
-    for &(r, c, _) in edges {
-        let a = find(&mut parent, r);
-        let b = find(&mut parent, rows + c);
-        if a != b {
-            parent[a] = b;
-        }
-    }
-    let mut by_root: std::collections::BTreeMap<usize, Vec<(usize, usize, i64)>> =
-        std::collections::BTreeMap::new();
-    for &e in edges {
-        let root = find(&mut parent, e.0);
-        by_root.entry(root).or_default().push(e);
-    }
-    for comp in by_root.values() {
-        if let [(r, c, _)] = comp.as_slice() {
-            out.push((*r, *c));
-            continue;
-        }
-        solve_component(comp, &mut out);
-    }
-    out.sort_unstable();
-    out
+    let mut a = Assigner {
+        edges: edges.to_vec(),
+        ..Assigner::default()
+    };
+    a.max_weight_pairs(rows, cols);
+    a.out
 }
 
 /// One connected component, dense, through `kuhn_munkres` (which wants rows ≤ columns).

@@ -70,14 +70,20 @@ pub fn run(args: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         }
         _ => {}
     }
-    let gt = read(&args.gt, rule.geometry())?;
+    // Both files at once (each parse is one pass over its text); errors in the order the
+    // files are named.
+    let (gt, hyp) = rayon::join(
+        || read(&args.gt, rule.geometry()),
+        || read(&args.hyp, rule.geometry()),
+    );
+    let gt = gt?;
     if gt.is_empty() {
         anyhow::bail!(
             "{}: no ground-truth rows, so MOTA, IDF1 and HOTA are undefined",
             args.gt.display()
         );
     }
-    let hyp = read(&args.hyp, rule.geometry())?;
+    let hyp = hyp?;
     // the sequence keeps what the metrics need (dense ids and geometry, grouped by frame);
     // the parsed rows go before the metrics run, and no per-frame events are collected
     let sequence = mot::Sequence::new(&gt, &hyp, rule)?;

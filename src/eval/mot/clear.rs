@@ -1,8 +1,8 @@
 //! CLEAR MOT accumulation, frame by frame, as py-motmetrics 1.4.0 `MOTAccumulator.update`
 //! (with `max_switch_time = ∞`) and the counts of `metrics.py`.
 
-use super::{Frame, Frames};
-use crate::assign::min_cost_max_pairs;
+use super::{AllowedFrame, AllowedFrames, Pair};
+use crate::assign::Assigner;
 
 /// An object is mostly tracked when matched in at least this share of its frames (Li et al.,
 /// CVPR 2009; motmetrics `mostly_tracked`).
@@ -143,15 +143,15 @@ struct ObjectTally {
 /// Run the accumulator over `frames` (ascending). `gt_ids` / `hyp_ids` map dense indices back
 /// to the input ids for the events, which are collected only when `keep_events`.
 pub(super) fn accumulate(
-    frames: &dyn Frames,
+    frames: &dyn AllowedFrames,
     gt_ids: &[i64],
     hyp_ids: &[i64],
     keep_events: bool,
 ) -> (ClearMot, Vec<Event>) {
     // motmetrics state: `m` (object → its last hypothesis), `res_m` (hypothesis → its last
     // object), `last_match` and `hypHistory` (only whether an entry exists is ever read).
-    let mut m: Vec<Option<usize>> = vec![None; gt_ids.len()];
-    let mut res_m: Vec<Option<usize>> = vec![None; hyp_ids.len()];
+    let mut m: Vec<Option<u32>> = vec![None; gt_ids.len()];
+    let mut res_m: Vec<Option<u32>> = vec![None; hyp_ids.len()];
     let mut ever_matched_gt = vec![false; gt_ids.len()];
     let mut ever_matched_hyp = vec![false; hyp_ids.len()];
     let mut tally = vec![ObjectTally::default(); gt_ids.len()];
@@ -159,92 +159,97 @@ pub(super) fn accumulate(
     let mut c = empty_counts(frames.num_frames() as u64);
     let mut gt_done = Vec::new();
     let mut hyp_done = Vec::new();
-    frames.each(&mut |f| {
+    let mut rest = Vec::new();
+    let mut assigner = Assigner::default();
+    let ids = (gt_ids, hyp_ids);
+    frames.each_allowed(&mut |f| {
         let (ng, nh) = (f.gt.len(), f.hyp.len());
         gt_done.clear();
         gt_done.resize(ng, false);
         hyp_done.clear();
         hyp_done.resize(nh, false);
-        if ng > 0 && nh > 0 {
-            // 1. Keep pairings from earlier frames that are still allowed.
-            for (i, &o) in f.gt.iter().enumerate() {
-                let Some(prev) = m[o] else { continue };
-                let Some(j) = (0..nh).find(|&j| !hyp_done[j] && f.hyp[j] == prev) else {
-                    continue;
-                };
-                if f.dist[i * nh + j].is_finite() {
-                    gt_done[i] = true;
-                    hyp_done[j] = true;
-                    ever_matched_gt[o] = true;
-                    ever_matched_hyp[prev] = true;
-                    record_match(
-                        f,
-                        i,
-                        j,
-                        EventKind::Match,
-                        (gt_ids, hyp_ids),
-                        &mut c,
-                        &mut events,
-                    );
-                }
-            }
-            // 2. Optimal assignment of the rest.
-            let pairs = min_cost_max_pairs(ng, nh, |i, j| {
-                if gt_done[i] || hyp_done[j] {
-                    f64::NAN
-                } else {
-                    f.dist[i * nh + j]
-                }
-            });
-            for (i, j) in pairs {
-                let (o, h) = (f.gt[i], f.hyp[j]);
-                let switch = m[o].is_some_and(|prev| prev != h);
-                if switch && !ever_matched_hyp[h] {
-                    c.num_ascend += 1;
-                }
-                if res_m[h].is_some_and(|prev| prev != o) {
-                    if !ever_matched_gt[o] {
-                        c.num_migrate += 1;
-                    }
-                    c.num_transfer += 1;
-                }
-                ever_matched_hyp[h] = true;
-                ever_matched_gt[o] = true;
-                let kind = if switch {
-                    EventKind::Switch
-                } else {
-                    EventKind::Match
-                };
-                record_match(f, i, j, kind, (gt_ids, hyp_ids), &mut c, &mut events);
+        // 1. Keep pairings from earlier frames that are still allowed (ids are unique in a
+        //    frame, so the previous hypothesis is at most one allowed pair of the object).
+        for p in f.pairs {
+            let (i, j) = (p.i as usize, p.j as usize);
+            let o = f.gt[i] as usize;
+            if !gt_done[i] && !hyp_done[j] && m[o] == Some(f.hyp[j]) {
                 gt_done[i] = true;
                 hyp_done[j] = true;
-                m[o] = Some(h);
-                res_m[h] = Some(o);
+                ever_matched_gt[o] = true;
+                ever_matched_hyp[f.hyp[j] as usize] = true;
+                record_match(f, p, EventKind::Match, ids, &mut c, &mut events);
             }
+        }
+        // 2. Optimal assignment of the rest.
+        rest.clear();
+        rest.extend(
+            f.pairs
+                .iter()
+                .filter(|p| !gt_done[p.i as usize] && !hyp_done[p.j as usize])
+                .map(|p| (p.i as usize, p.j as usize, p.dist)),
+        );
+        for &(i, j) in assigner.min_cost_max_pairs(ng, nh, &rest) {
+            let (o, h) = (f.gt[i], f.hyp[j]);
+            let switch = m[o as usize].is_some_and(|prev| prev != h);
+            if switch && !ever_matched_hyp[h as usize] {
+                c.num_ascend += 1;
+            }
+            if res_m[h as usize].is_some_and(|prev| prev != o) {
+                if !ever_matched_gt[o as usize] {
+                    c.num_migrate += 1;
+                }
+                c.num_transfer += 1;
+            }
+            ever_matched_hyp[h as usize] = true;
+            ever_matched_gt[o as usize] = true;
+            let kind = if switch {
+                EventKind::Switch
+            } else {
+                EventKind::Match
+            };
+            let dist = rest
+                .iter()
+                .find(|e| (e.0, e.1) == (i, j))
+                .map_or(f64::NAN, |e| e.2);
+            let p = Pair {
+                i: i as u32,
+                j: j as u32,
+                dist,
+            };
+            record_match(f, &p, kind, ids, &mut c, &mut events);
+            gt_done[i] = true;
+            hyp_done[j] = true;
+            m[o as usize] = Some(h);
+            res_m[h as usize] = Some(o);
         }
         // 3. Unmatched objects are missed; 4. unmatched hypotheses are false positives.
         for i in (0..ng).filter(|&i| !gt_done[i]) {
-            events.push(Event {
-                frame: f.frame,
-                kind: EventKind::Miss,
-                gt_id: Some(gt_ids[f.gt[i]]),
-                hyp_id: None,
-                distance: None,
-            });
+            if keep_events {
+                events.push(Event {
+                    frame: f.frame,
+                    kind: EventKind::Miss,
+                    gt_id: Some(gt_ids[f.gt[i] as usize]),
+                    hyp_id: None,
+                    distance: None,
+                });
+            }
             c.num_misses += 1;
         }
         for j in (0..nh).filter(|&j| !hyp_done[j]) {
-            events.push(Event {
-                frame: f.frame,
-                kind: EventKind::FalsePositive,
-                gt_id: None,
-                hyp_id: Some(hyp_ids[f.hyp[j]]),
-                distance: None,
-            });
+            if keep_events {
+                events.push(Event {
+                    frame: f.frame,
+                    kind: EventKind::FalsePositive,
+                    gt_id: None,
+                    hyp_id: Some(hyp_ids[f.hyp[j] as usize]),
+                    distance: None,
+                });
+            }
             c.num_false_positives += 1;
         }
         for (i, &o) in f.gt.iter().enumerate() {
-            let t = &mut tally[o];
+            let t = &mut tally[o as usize];
             t.frames += 1;
             if gt_done[i] {
                 t.tracked += 1;
@@ -312,25 +317,23 @@ fn count_objects(tally: &[ObjectTally], c: &mut ClearMot) {
     }
 }
 
-/// Append a MATCH or SWITCH event for frame-local pair `(i, j)` and count it.
+/// Append a MATCH or SWITCH event for an allowed pair of the frame and count it.
 fn record_match(
-    f: &Frame,
-    i: usize,
-    j: usize,
+    f: &AllowedFrame,
+    p: &Pair,
     kind: EventKind,
     (gt_ids, hyp_ids): (&[i64], &[i64]),
     c: &mut ClearMot,
     events: &mut Vec<Event>,
 ) {
-    let d = f.dist[i * f.hyp.len() + j];
     events.push(Event {
         frame: f.frame,
         kind,
-        gt_id: Some(gt_ids[f.gt[i]]),
-        hyp_id: Some(hyp_ids[f.hyp[j]]),
-        distance: Some(d),
+        gt_id: Some(gt_ids[f.gt[p.i as usize] as usize]),
+        hyp_id: Some(hyp_ids[f.hyp[p.j as usize] as usize]),
+        distance: Some(p.dist),
     });
-    c.total_distance += d;
+    c.total_distance += p.dist;
     match kind {
         EventKind::Switch => c.num_switches += 1,
         _ => c.num_matches += 1,
@@ -339,6 +342,7 @@ fn record_match(
 
 #[cfg(test)]
 mod tests {
+    use super::super::Frame;
     use super::*;
 
     const X: f64 = f64::NAN;

@@ -8,9 +8,7 @@
 //! that is the matching that minimises IDFN + IDFP, because
 //! IDFN = GT − IDTP and IDFP = predictions − IDTP.
 
-use std::collections::HashMap;
-
-use super::Frames;
+use super::AllowedFrames;
 use crate::assign::max_count_pairs;
 
 /// IDF1 and its parts. Ratios are NaN where their denominator is zero.
@@ -53,27 +51,39 @@ impl IdMetrics {
     }
 }
 
-pub(super) fn compute(frames: &dyn Frames, n_gt: usize, n_hyp: usize) -> IdMetrics {
-    let mut agree: HashMap<(usize, usize), u64> = HashMap::new();
+pub(super) fn compute(frames: &dyn AllowedFrames, n_gt: usize, n_hyp: usize) -> IdMetrics {
+    // Frames in which each (object, hypothesis) pair agrees, per object: an object meets
+    // few hypotheses, and the one of its previous frame most often, so a short list searched
+    // from its end beats a map.
+    let mut agree: Vec<Vec<(u32, u64)>> = vec![Vec::new(); n_gt];
     let (mut num_gt, mut num_hyp) = (0u64, 0u64);
-    frames.each(&mut |f| {
-        let nh = f.hyp.len();
+    frames.each_allowed(&mut |f| {
         num_gt += f.gt.len() as u64;
-        num_hyp += nh as u64;
-        for (i, &o) in f.gt.iter().enumerate() {
-            for (j, &h) in f.hyp.iter().enumerate() {
-                if f.dist[i * nh + j].is_finite() {
-                    *agree.entry((o, h)).or_default() += 1;
-                }
+        num_hyp += f.hyp.len() as u64;
+        for p in f.pairs {
+            let (o, h) = (f.gt[p.i as usize] as usize, f.hyp[p.j as usize]);
+            let list = &mut agree[o];
+            match list.iter_mut().rev().find(|e| e.0 == h) {
+                Some(e) => e.1 += 1,
+                None => list.push((h, 1)),
             }
         }
     });
-    let mut edges: Vec<(usize, usize, u64)> = agree.iter().map(|(&(o, h), &n)| (o, h, n)).collect();
-    // Sorted, so ties between equally good matchings break the same way on every run.
-    edges.sort_unstable();
+    // Sorted by (object, hypothesis), so ties between equally good matchings break the same
+    // way on every run.
+    let mut edges: Vec<(usize, usize, u64)> = Vec::new();
+    for (o, list) in agree.iter_mut().enumerate() {
+        list.sort_unstable();
+        edges.extend(list.iter().map(|&(h, n)| (o, h as usize, n)));
+    }
+    let count = |(o, h): (usize, usize)| {
+        agree[o]
+            .binary_search_by_key(&(h as u32), |e| e.0)
+            .map_or(0, |k| agree[o][k].1)
+    };
     let idtp: u64 = max_count_pairs(n_gt, n_hyp, &edges)
-        .iter()
-        .map(|p| agree.get(p).copied().unwrap_or(0))
+        .into_iter()
+        .map(count)
         .sum();
     // `frames` hold every observation once, so the totals are GT and predictions.
     IdMetrics::from_counts(idtp, num_hyp - idtp, num_gt - idtp)

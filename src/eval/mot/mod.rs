@@ -49,8 +49,7 @@ mod hota;
 mod identity;
 mod moda;
 mod motchallenge;
-
-use std::collections::HashMap;
+mod sequence;
 
 pub use clear::{ClearMot, Event, EventKind};
 pub use error::{MotError, Side};
@@ -58,6 +57,8 @@ pub use hota::{HOTA_ALPHAS, Hota, HotaAtAlpha, hota_alpha};
 pub use identity::IdMetrics;
 pub use moda::{Moda, PointFrame, moda_modp};
 pub use motchallenge::{parse_motchallenge, write_motchallenge};
+pub use sequence::Sequence;
+pub(crate) use sequence::{AllowedFrame, AllowedFrames, Pair};
 
 /// An axis-aligned image box in pixels: top-left corner, width and height.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -229,64 +230,6 @@ impl Frames for &[Frame] {
     }
 }
 
-/// One side's rows of a frame: `start..end` in [`Sequence`]'s row arrays.
-#[derive(Debug, Clone, Copy)]
-struct Span {
-    frame: i64,
-    gt: (u32, u32),
-    hyp: (u32, u32),
-}
-
-/// One observation as a [`Sequence`] keeps it: dense id and geometry.
-#[derive(Debug, Clone, Copy)]
-struct Row {
-    id: u32,
-    geometry: Geometry,
-}
-
-/// Ground truth and hypotheses of one sequence, checked and grouped by frame (rows in frame
-/// order, within a frame in input order), under a [`MatchRule`]: build once, then compute any
-/// of the metrics. Pairwise distances are computed per frame as the metrics visit it.
-#[derive(Debug, Clone)]
-pub struct Sequence {
-    rule: MatchRule,
-    gt_ids: Vec<i64>,
-    hyp_ids: Vec<i64>,
-    spans: Vec<Span>,
-    gt_rows: Vec<Row>,
-    hyp_rows: Vec<Row>,
-}
-
-impl Frames for Sequence {
-    fn num_frames(&self) -> usize {
-        self.spans.len()
-    }
-
-    fn each(&self, visit: &mut dyn FnMut(&Frame)) {
-        let max_dist = self.rule.max_dist();
-        let mut f = Frame::default();
-        for s in &self.spans {
-            let g = &self.gt_rows[s.gt.0 as usize..s.gt.1 as usize];
-            let h = &self.hyp_rows[s.hyp.0 as usize..s.hyp.1 as usize];
-            f.frame = s.frame;
-            f.gt.clear();
-            f.gt.extend(g.iter().map(|r| r.id as usize));
-            f.hyp.clear();
-            f.hyp.extend(h.iter().map(|r| r.id as usize));
-            f.dist.clear();
-            f.sim.clear();
-            for a in g {
-                for b in h {
-                    let (d, s) = pair(&a.geometry, &b.geometry, self.rule, max_dist);
-                    f.dist.push(d);
-                    f.sim.push(s);
-                }
-            }
-            visit(&f);
-        }
-    }
-}
-
 /// All metrics of one sequence (or of several, combined with [`Metrics::overall`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Metrics {
@@ -312,109 +255,13 @@ pub fn evaluate(
 }
 
 impl Sequence {
-    /// Check the observations (finite, the geometry the rule needs, one row per id and frame)
-    /// and group them by frame. Frames are those where either side has an observation,
-    /// ascending; within a frame, observations keep their input order (which decides ties,
-    /// as in motmetrics).
-    pub fn new(gt: &[Observation], hyp: &[Observation], rule: MatchRule) -> Result<Self, MotError> {
-        rule.validate()?;
-        for (obs, side) in [(gt, Side::GroundTruth), (hyp, Side::Hypothesis)] {
-            if u32::try_from(obs.len()).is_err() {
-                return Err(MotError::TooLarge { side });
-            }
-        }
-        let (gt_ids, gt_dense) = intern(gt, Side::GroundTruth, rule)?;
-        let (hyp_ids, hyp_dense) = intern(hyp, Side::Hypothesis, rule)?;
-        // rows of each side in (frame, input order): a stable sort of their indices
-        let order = |obs: &[Observation]| {
-            let mut idx: Vec<u32> = (0..obs.len() as u32).collect();
-            idx.sort_by_key(|&k| obs[k as usize].frame);
-            idx
-        };
-        let (gt_order, hyp_order) = (order(gt), order(hyp));
-        // Frame index in which each dense id was last seen, to find an id twice in a frame.
-        let mut gt_seen = vec![usize::MAX; gt_ids.len()];
-        let mut hyp_seen = vec![usize::MAX; hyp_ids.len()];
-        let mut spans: Vec<Span> = Vec::new();
-        let mut gt_rows = Vec::with_capacity(gt.len());
-        let mut hyp_rows = Vec::with_capacity(hyp.len());
-        let (mut gi, mut hi) = (0, 0);
-        while gi < gt_order.len() || hi < hyp_order.len() {
-            let frame_of = |order: &[u32], k: usize, obs: &[Observation]| {
-                order.get(k).map(|&r| obs[r as usize].frame)
-            };
-            let frame = match (frame_of(&gt_order, gi, gt), frame_of(&hyp_order, hi, hyp)) {
-                (Some(a), Some(b)) => a.min(b),
-                (Some(a), None) | (None, Some(a)) => a,
-                (None, None) => break,
-            };
-            let fi = spans.len();
-            let mut span = Span {
-                frame,
-                gt: (gt_rows.len() as u32, 0),
-                hyp: (hyp_rows.len() as u32, 0),
-            };
-            for (order, k, dense, seen, side, obs, rows) in [
-                (
-                    &gt_order,
-                    &mut gi,
-                    &gt_dense,
-                    &mut gt_seen,
-                    Side::GroundTruth,
-                    gt,
-                    &mut gt_rows,
-                ),
-                (
-                    &hyp_order,
-                    &mut hi,
-                    &hyp_dense,
-                    &mut hyp_seen,
-                    Side::Hypothesis,
-                    hyp,
-                    &mut hyp_rows,
-                ),
-            ] {
-                while let Some(&r) = order.get(*k) {
-                    let o = &obs[r as usize];
-                    if o.frame != frame {
-                        break;
-                    }
-                    let d = dense[r as usize];
-                    if std::mem::replace(&mut seen[d as usize], fi) == fi {
-                        return Err(MotError::DuplicateId {
-                            side,
-                            frame,
-                            id: o.id,
-                        });
-                    }
-                    rows.push(Row {
-                        id: d,
-                        geometry: o.geometry,
-                    });
-                    *k += 1;
-                }
-            }
-            span.gt.1 = gt_rows.len() as u32;
-            span.hyp.1 = hyp_rows.len() as u32;
-            spans.push(span);
-        }
-        Ok(Sequence {
-            rule,
-            gt_ids,
-            hyp_ids,
-            spans,
-            gt_rows,
-            hyp_rows,
-        })
-    }
-
     pub fn rule(&self) -> MatchRule {
         self.rule
     }
 
     /// Frames in which either side has an observation.
     pub fn num_frames(&self) -> usize {
-        self.spans.len()
+        Frames::num_frames(self)
     }
 
     /// CLEAR MOT and its per-frame events.
@@ -471,46 +318,10 @@ impl Metrics {
     }
 }
 
-/// Check one side's observations and map its ids to dense indices (in order of first
-/// appearance). Returns (dense → original id, per-observation dense index).
-fn intern(
-    obs: &[Observation],
-    side: Side,
-    rule: MatchRule,
-) -> Result<(Vec<i64>, Vec<u32>), MotError> {
-    let mut ids = Vec::new();
-    let mut index: HashMap<i64, u32> = HashMap::new();
-    let mut dense = Vec::with_capacity(obs.len());
-    for o in obs {
-        if !(o.geometry.is_finite() && o.confidence.is_finite()) {
-            return Err(MotError::NonFinite {
-                side,
-                frame: o.frame,
-                id: o.id,
-            });
-        }
-        if o.geometry.kind() != rule.geometry() {
-            return Err(MotError::WrongGeometry {
-                side,
-                frame: o.frame,
-                id: o.id,
-                rule: rule.name(),
-                expected: rule.geometry().name(),
-                found: o.geometry.kind().name(),
-            });
-        }
-        let next = u32::try_from(ids.len()).map_err(|_| MotError::TooLarge { side })?;
-        let d = *index.entry(o.id).or_insert(next);
-        if d == next {
-            ids.push(o.id);
-        }
-        dense.push(d);
-    }
-    Ok((ids, dense))
-}
-
 /// (CLEAR distance or NaN when not allowed, HOTA similarity) of one pair. `max_dist` is
-/// 1 − min_iou for boxes and max_m² for points.
+/// 1 − min_iou for boxes and max_m² for points. (The metrics use the same formulas on
+/// prepared geometry, in `sequence`; this is their reference.)
+#[cfg(test)]
 fn pair(g: &Geometry, h: &Geometry, rule: MatchRule, max_dist: f64) -> (f64, f64) {
     match (g, h, rule) {
         (Geometry::Box(a), Geometry::Box(b), MatchRule::Iou { .. }) => {

@@ -32,98 +32,61 @@ const COLUMNS: [&str; 10] = [
 ];
 
 /// Parse MOTChallenge CSV text; `path` only names the source in errors.
-pub fn parse_motchallenge<'a>(
-    text: &'a str,
+///
+/// Rows in the canonical form (comma-separated, no spaces, plain decimal numbers, finite and
+/// valid) take a byte-level path that never splits a row into strings; any other row takes
+/// the general path, which accepts exactly what the module doc says and names the file,
+/// line and column of what it refuses. Both paths give the same values (numbers are
+/// correctly rounded either way).
+pub fn parse_motchallenge(
+    text: &str,
     path: &Path,
     kind: GeometryKind,
 ) -> Result<Vec<Observation>, MotError> {
-    let (min_cols, expected) = match kind {
-        GeometryKind::Box => (6, "6 to 10"),
-        GeometryKind::Point => (9, "9 or 10 for ground-plane points"),
+    let min_cols = match kind {
+        GeometryKind::Box => 6,
+        GeometryKind::Point => 9,
     };
     // A rough row count, to grow the tables once or twice rather than a dozen times.
     let rows_guess = text.len() / 48;
     let mut out = Vec::with_capacity(rows_guess);
-    let mut first_line: HashMap<(i64, i64), usize> = HashMap::with_capacity(rows_guess);
+    let mut lines = Vec::with_capacity(rows_guess);
     let mut any_ground_plane = false;
-    for (k, raw) in text.lines().enumerate() {
-        let line = k + 1;
-        let row = raw.trim();
-        if row.is_empty() {
-            continue;
-        }
-        let mut fields = [""; COLUMNS.len()];
-        let mut n = 0;
-        let mut take = |f: &'a str| {
-            if let Some(slot) = fields.get_mut(n) {
-                *slot = f;
+    let bytes = text.as_bytes();
+    let (mut pos, mut line) = (0, 0);
+    while pos < bytes.len() {
+        line += 1;
+        let parsed = match fast_row(bytes, pos, kind, min_cols) {
+            Some((o, next)) => {
+                pos = next;
+                Some(o)
             }
-            n += 1;
-        };
-        if row.contains(',') {
-            row.split(',').map(str::trim).for_each(&mut take);
-        } else {
-            row.split_whitespace().for_each(&mut take);
-        }
-        if n < min_cols || n > COLUMNS.len() {
-            return Err(MotError::ColumnCount {
-                path: path.to_path_buf(),
-                line,
-                found: n,
-                expected,
-            });
-        }
-        let integer = |c: usize| {
-            parse_integer(fields[c]).ok_or_else(|| bad(path, line, c, fields[c], "an integer"))
-        };
-        let number = |c: usize| {
-            parse_finite(fields[c]).ok_or_else(|| bad(path, line, c, fields[c], "a finite number"))
-        };
-        let frame = integer(0)?;
-        let id = integer(1)?;
-        let confidence = if n > 6 { number(6)? } else { 1.0 };
-        let geometry = match kind {
-            GeometryKind::Box => {
-                let (width_px, height_px) = (number(4)?, number(5)?);
-                for (c, v) in [(4, width_px), (5, height_px)] {
-                    if v < 0.0 {
-                        return Err(MotError::NegativeSize {
-                            path: path.to_path_buf(),
-                            line,
-                            column: COLUMNS[c],
-                            value: v,
-                        });
-                    }
+            None => {
+                let end = bytes[pos..]
+                    .iter()
+                    .position(|&b| b == b'\n')
+                    .map_or(bytes.len(), |k| pos + k);
+                let raw = &text[pos..end];
+                pos = end + 1;
+                match parse_row(raw.strip_suffix('\r').unwrap_or(raw), path, line, kind) {
+                    Ok(o) => o,
+                    // A duplicate on an earlier line is the first error in the file.
+                    Err(e) => return Err(duplicate_error(&out, &lines, path).unwrap_or(e)),
                 }
-                Geometry::Box(BoxPx {
-                    left_px: number(2)?,
-                    top_px: number(3)?,
-                    width_px,
-                    height_px,
-                })
-            }
-            GeometryKind::Point => {
-                let (x_m, y_m) = (number(7)?, number(8)?);
-                any_ground_plane |= !(x_m == -1.0 && y_m == -1.0);
-                Geometry::Point(GroundPoint { x_m, y_m })
             }
         };
-        if let Some(&first) = first_line.get(&(frame, id)) {
-            return Err(MotError::DuplicateRow {
-                path: path.to_path_buf(),
-                line,
-                first_line: first,
-                frame,
-                id,
-            });
+        if let Some(o) = parsed {
+            if let Geometry::Point(p) = o.geometry {
+                any_ground_plane |= !(p.x_m == -1.0 && p.y_m == -1.0);
+            }
+            out.push(o);
+            lines.push(line);
         }
-        first_line.insert((frame, id), line);
-        out.push(Observation {
-            frame,
-            id,
-            geometry,
-            confidence,
-        });
+    }
+    if has_duplicates(&out) {
+        if let Some(e) = duplicate_error(&out, &lines, path) {
+            return Err(e);
+        }
     }
     if kind == GeometryKind::Point && !out.is_empty() && !any_ground_plane {
         return Err(MotError::NoGroundPlane {
@@ -131,6 +94,235 @@ pub fn parse_motchallenge<'a>(
         });
     }
     Ok(out)
+}
+
+/// What a column holds for one kind of file.
+#[derive(Clone, Copy, PartialEq)]
+enum Role {
+    Integer,
+    Number,
+    Ignored,
+}
+
+fn role(kind: GeometryKind, column: usize) -> Role {
+    match (kind, column) {
+        (_, 0 | 1) => Role::Integer,
+        (_, 6) | (GeometryKind::Box, 2..=5) | (GeometryKind::Point, 7 | 8) => Role::Number,
+        _ => Role::Ignored,
+    }
+}
+
+/// The row starting at `pos` if it is in the canonical form, and where the next row starts;
+/// `None` sends the row to [`parse_row`] (anything unusual, including every error).
+fn fast_row(
+    bytes: &[u8],
+    mut pos: usize,
+    kind: GeometryKind,
+    min_cols: usize,
+) -> Option<(Observation, usize)> {
+    let mut ints = [0i64; 2];
+    let mut nums = [0.0f64; COLUMNS.len()];
+    let mut n = 0;
+    loop {
+        if n == COLUMNS.len() {
+            return None;
+        }
+        match role(kind, n) {
+            Role::Integer => {
+                let (v, next) = fast_integer(bytes, pos)?;
+                ints[n] = v;
+                pos = next;
+            }
+            Role::Number => {
+                // '+', '.', "inf", "nan" and the like go the general way.
+                if !matches!(bytes.get(pos), Some(b'-' | b'0'..=b'9')) {
+                    return None;
+                }
+                let (v, used) = fast_float2::parse_partial::<f64, _>(&bytes[pos..]).ok()?;
+                if used == 0 || !v.is_finite() {
+                    return None;
+                }
+                nums[n] = v;
+                pos += used;
+            }
+            Role::Ignored => {
+                while !matches!(bytes.get(pos), None | Some(b',' | b'\n')) {
+                    pos += 1;
+                }
+            }
+        }
+        n += 1;
+        match bytes.get(pos) {
+            Some(b',') => pos += 1,
+            Some(b'\n') => {
+                pos += 1;
+                break;
+            }
+            Some(b'\r') if bytes.get(pos + 1) == Some(&b'\n') => {
+                pos += 2;
+                break;
+            }
+            None => break,
+            Some(_) => return None,
+        }
+    }
+    if n < min_cols {
+        return None;
+    }
+    let geometry = match kind {
+        GeometryKind::Box => {
+            if nums[4] < 0.0 || nums[5] < 0.0 {
+                return None;
+            }
+            Geometry::Box(BoxPx {
+                left_px: nums[2],
+                top_px: nums[3],
+                width_px: nums[4],
+                height_px: nums[5],
+            })
+        }
+        GeometryKind::Point => Geometry::Point(GroundPoint {
+            x_m: nums[7],
+            y_m: nums[8],
+        }),
+    };
+    let o = Observation {
+        frame: ints[0],
+        id: ints[1],
+        geometry,
+        confidence: if n > 6 { nums[6] } else { 1.0 },
+    };
+    Some((o, pos))
+}
+
+/// `-?[0-9]{1,18}` at `pos` (anything else, such as `12.0`, goes the general way).
+fn fast_integer(bytes: &[u8], mut pos: usize) -> Option<(i64, usize)> {
+    let negative = bytes.get(pos) == Some(&b'-');
+    pos += negative as usize;
+    let start = pos;
+    let mut v: i64 = 0;
+    while let Some(&b @ b'0'..=b'9') = bytes.get(pos) {
+        if pos - start == 18 {
+            return None;
+        }
+        v = v * 10 + (b - b'0') as i64;
+        pos += 1;
+    }
+    (pos > start).then_some((if negative { -v } else { v }, pos))
+}
+
+/// One row by the general rules (`raw` without its line break): `None` for a blank line.
+fn parse_row<'a>(
+    raw: &'a str,
+    path: &Path,
+    line: usize,
+    kind: GeometryKind,
+) -> Result<Option<Observation>, MotError> {
+    let (min_cols, expected) = match kind {
+        GeometryKind::Box => (6, "6 to 10"),
+        GeometryKind::Point => (9, "9 or 10 for ground-plane points"),
+    };
+    let row = raw.trim();
+    if row.is_empty() {
+        return Ok(None);
+    }
+    let mut fields = [""; COLUMNS.len()];
+    let mut n = 0;
+    let mut take = |f: &'a str| {
+        if let Some(slot) = fields.get_mut(n) {
+            *slot = f;
+        }
+        n += 1;
+    };
+    if row.contains(',') {
+        row.split(',').map(str::trim).for_each(&mut take);
+    } else {
+        row.split_whitespace().for_each(&mut take);
+    }
+    if n < min_cols || n > COLUMNS.len() {
+        return Err(MotError::ColumnCount {
+            path: path.to_path_buf(),
+            line,
+            found: n,
+            expected,
+        });
+    }
+    let integer = |c: usize| {
+        parse_integer(fields[c]).ok_or_else(|| bad(path, line, c, fields[c], "an integer"))
+    };
+    let number = |c: usize| {
+        parse_finite(fields[c]).ok_or_else(|| bad(path, line, c, fields[c], "a finite number"))
+    };
+    let frame = integer(0)?;
+    let id = integer(1)?;
+    let confidence = if n > 6 { number(6)? } else { 1.0 };
+    let geometry = match kind {
+        GeometryKind::Box => {
+            let (width_px, height_px) = (number(4)?, number(5)?);
+            for (c, v) in [(4, width_px), (5, height_px)] {
+                if v < 0.0 {
+                    return Err(MotError::NegativeSize {
+                        path: path.to_path_buf(),
+                        line,
+                        column: COLUMNS[c],
+                        value: v,
+                    });
+                }
+            }
+            Geometry::Box(BoxPx {
+                left_px: number(2)?,
+                top_px: number(3)?,
+                width_px,
+                height_px,
+            })
+        }
+        GeometryKind::Point => Geometry::Point(GroundPoint {
+            x_m: number(7)?,
+            y_m: number(8)?,
+        }),
+    };
+    Ok(Some(Observation {
+        frame,
+        id,
+        geometry,
+        confidence,
+    }))
+}
+
+/// Whether some (frame, id) occurs twice. Files are usually in frame order: then each
+/// frame's ids are checked on their own; otherwise all keys are sorted.
+fn has_duplicates(rows: &[Observation]) -> bool {
+    let mut ids: Vec<i64> = Vec::new();
+    if rows.is_sorted_by_key(|o| o.frame) {
+        rows.chunk_by(|a, b| a.frame == b.frame).any(|run| {
+            ids.clear();
+            ids.extend(run.iter().map(|o| o.id));
+            ids.sort_unstable();
+            ids.windows(2).any(|w| w[0] == w[1])
+        })
+    } else {
+        let mut keys: Vec<(i64, i64)> = rows.iter().map(|o| (o.frame, o.id)).collect();
+        keys.sort_unstable();
+        keys.windows(2).any(|w| w[0] == w[1])
+    }
+}
+
+/// The first line (in file order) that repeats an earlier row's (frame, id), if any.
+fn duplicate_error(rows: &[Observation], lines: &[usize], path: &Path) -> Option<MotError> {
+    let mut first_line: HashMap<(i64, i64), usize> = HashMap::with_capacity(rows.len());
+    for (o, &line) in rows.iter().zip(lines) {
+        if let Some(&first) = first_line.get(&(o.frame, o.id)) {
+            return Some(MotError::DuplicateRow {
+                path: path.to_path_buf(),
+                line,
+                first_line: first,
+                frame: o.frame,
+                id: o.id,
+            });
+        }
+        first_line.insert((o.frame, o.id), line);
+    }
+    None
 }
 
 /// MOTChallenge CSV text, one row per observation in the given order; unused columns are
@@ -308,6 +500,68 @@ mod tests {
             let got = err(text, *kind);
             assert!(got.contains(want), "{text:?}: got `{got}`, want `{want}`");
         }
+    }
+
+    /// Every row the byte-level path accepts, the general path reads to the same bits.
+    #[test]
+    fn fast_rows_equal_general_rows() {
+        let rows = [
+            "1,3,113.84,274.5,57.307,130.05,-1,-1,-1,-1",
+            "2,-4,0.1,2,3,4",
+            "2,4,1e3,-2.5E-3,0.30000000000000004,1.7976931348623157e308,0.5",
+            "7,1,-0,5.,1.e2,00012.5000,1,a,b,c",
+            "999999999999999999,-999999999999999999,1,1,1,1,1,,,",
+            "3,1,-1,-1,-1,-1,1,2.5,-0.75,0",
+            "3,1,1,1,1,1,1,2.5,-0.75",
+        ];
+        let mut fast = 0;
+        for kind in [GeometryKind::Box, GeometryKind::Point] {
+            let min_cols = if kind == GeometryKind::Box { 6 } else { 9 };
+            for row in rows {
+                for end in ["", "\n", "\r\n"] {
+                    let text = format!("{row}{end}");
+                    let general = parse_row(row, Path::new("x"), 1, kind);
+                    let Some((o, next)) = fast_row(text.as_bytes(), 0, kind, min_cols) else {
+                        continue;
+                    };
+                    fast += 1;
+                    assert_eq!(next, text.len(), "{text:?}");
+                    let g = general.expect("the general path reads it").expect("a row");
+                    assert_eq!(format!("{o:?}"), format!("{g:?}"), "{text:?}");
+                }
+            }
+        }
+        assert!(fast >= 15, "{fast} rows took the fast path");
+        // Not canonical: the general path decides (and may accept).
+        for row in [
+            "1, 2,0,0,1,1",
+            "1 2 0 0 1 1",
+            "+1,2,0,0,1,1",
+            "1,2,.5,0,1,1",
+            "1,2.0,0,0,1,1",
+        ] {
+            assert!(
+                fast_row(row.as_bytes(), 0, GeometryKind::Box, 6).is_none(),
+                "{row}"
+            );
+            assert!(parse(row, GeometryKind::Box).is_ok(), "{row}");
+        }
+    }
+
+    #[test]
+    fn the_first_error_in_the_file_is_reported() {
+        // A duplicate on line 2 comes before a bad number on line 3 ...
+        let text = "1,1,0,0,1,1\n1,1,0,0,1,1\n1,2,0,0,x,1\n";
+        assert!(err(text, GeometryKind::Box).contains("hyp.txt:2: frame 1 has id 1 a second time"));
+        // ... and, in a file out of frame order, the earliest repeat names its first line.
+        let text = "2,5,0,0,1,1\n1,7,0,0,1,1\n1,8,0,0,1,1\n2,5,0,0,1,1\n1,7,0,0,1,1\n";
+        assert!(
+            err(text, GeometryKind::Box)
+                .contains("hyp.txt:4: frame 2 has id 5 a second time (first on line 1)")
+        );
+        // Blank and \r\n lines keep the line count.
+        let text = "1,1,0,0,1,1\r\n\n  \n1,2,0,0,1,y\n";
+        assert!(err(text, GeometryKind::Box).contains("hyp.txt:4: column `bb_height` is `y`"));
     }
 
     #[test]
