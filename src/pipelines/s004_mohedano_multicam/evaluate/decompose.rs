@@ -57,7 +57,11 @@ pub(crate) use rows::{GhostRow, SplitRow};
 
 /// The main run and the frame-by-frame run, those present.
 fn runs(s: &Scored) -> Vec<Key> {
-    let per_frame = (format!("{}_per_frame", s.main.0), s.main.1.clone(), s.main.2);
+    let per_frame = (
+        format!("{}_per_frame", s.main.0),
+        s.main.1.clone(),
+        s.main.2,
+    );
     [s.main.clone(), per_frame]
         .into_iter()
         .filter(|k| s.keys.contains(k))

@@ -217,3 +217,45 @@ fn an_object_missed_for_n_dis_frames_is_discarded() {
     assert!(cyl[0].measured.is_none());
     assert!(t.step(&[]).0.is_empty(), "gone after N_dis = 2");
 }
+
+#[test]
+fn on_the_office_rig_the_ground_association_finds_the_paper_s_people() {
+    // the scalable test's scene (four people walking past each other in the paper's four
+    // corner cameras, lens distortion on, boxes of 0.2 m cylinders): from the frame N_app
+    // promotes them on, both report the same people on the same views every frame; the
+    // ground positions differ by the box bottom lying on the near rim of the base, not the
+    // axis (within the 0.25 m radius)
+    use super::super::tests::objects_for;
+    let views = office_views(true);
+    let mut runs = Vec::new();
+    for association in [Association::Paper, Association::Ground] {
+        let p = CylinderParams {
+            association,
+            ..Default::default()
+        };
+        let mut t = CylinderTracker::new(views.clone(), p).expect("tracker");
+        let mut frames = Vec::new();
+        for k in 0..20 {
+            let s = 0.05 * f64::from(k);
+            let people = [
+                (1, 2.0 + s, 2.0, 1.8, 0.2),
+                (2, 6.0 - s, 2.2, 1.7, 0.22),
+                (3, 3.0, 6.5 - s, 1.65, 0.2),
+                (4, 5.5, 5.0 + 0.5 * s, 1.9, 0.25),
+            ];
+            frames.push(t.step(&objects_for(&views, &people)).0);
+        }
+        runs.push(frames);
+    }
+    for (k, (paper, ground)) in runs[0].iter().zip(&runs[1]).enumerate().skip(4) {
+        assert_eq!(paper.len(), 4, "frame {k}: paper {paper:?}");
+        assert_eq!(ground.len(), 4, "frame {k}: ground {ground:?}");
+        for g in ground {
+            let p = paper
+                .iter()
+                .find(|p| p.support == g.support)
+                .unwrap_or_else(|| panic!("frame {k}: {:?} not in the paper's", g.support));
+            assert!((p.x_m - g.x_m).hypot(p.y_m - g.y_m) < 0.25, "{p:?} {g:?}");
+        }
+    }
+}
