@@ -189,3 +189,43 @@ pub(super) fn splits(s: &Scored, p: &Params) -> anyhow::Result<Table> {
     )
     .with_note("Frames are numbered per session from 0. `<detector>_per_frame` has no temporal stage: its identities are new every frame, so only its MODA, MODP, FP and FN mean something."))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipelines::s004_mohedano_multicam::evaluate::testdata;
+
+    #[test]
+    fn ghosts_and_splits_count_what_clear_mot_counts() {
+        // the main run of the test sessions (templates): 10 person-frames, no track in the
+        // first 3 frames, 0.7 m off in 2 (clear_mot's test): 5 found, 5 missed, 2 ghosts
+        let s = testdata::scored();
+        let rows = GhostRow::read(&ghosts(&s).expect("ghosts").df).expect("rows");
+        let sum = |side: &str| {
+            rows.iter()
+                .filter(|r| r.detector == "templates" && r.side == side)
+                .fold((0, 0, 0), |a, r| {
+                    (a.0 + r.count, a.1 + r.matched, a.2 + r.unmatched)
+                })
+        };
+        assert_eq!(sum("annotated"), (10, 5, 5));
+        assert_eq!(sum("reported"), (7, 5, 2));
+        let p = Params {
+            split_frame: 3,
+            ..Params::default()
+        };
+        let rows = SplitRow::read(&splits(&s, &p).expect("splits").df).expect("rows");
+        let got: Vec<(&str, &str, i64, i64, i64)> = rows
+            .iter()
+            .map(|r| (r.detector.as_str(), r.frames.as_str(), r.GT, r.FP, r.FN))
+            .collect();
+        // nothing reported before frame 3: every person there a miss
+        let before = got[0];
+        assert_eq!((before.0, before.1, before.3), ("templates", "0–2", 0));
+        assert_eq!(before.2, before.4);
+        let all = got.iter().find(|g| g.1 == "all").expect("all");
+        assert_eq!((all.2, all.3, all.4), (10, 2, 5));
+        assert_eq!(got[0].2 + got[1].2, 10);
+        assert!((rows[2].MOTA - 0.3).abs() < 1e-12, "{rows:?}");
+    }
+}
