@@ -20,8 +20,11 @@
 //! ground point; two cameras give eight equations for three unknowns, so a wrong pair is
 //! rejected by the feet *and* by the box heights (range), unlike two head rays alone.
 //!
-//! **Per frame** (`detect_ground`): (1) every pair of boxes in different cameras is fitted; a
-//! valid pair is a seed. (2) A seed grows camera by camera: the boxes of a camera it lacks
+//! **Per frame** (`detect_ground`): (1) every pair of boxes in different cameras whose
+//! one-camera segments project near each other (within `PAIR_GATE · p_Th`, either way) is
+//! fitted; a valid pair is a seed. (2) Seeds, best `E_c` first, grow camera by camera (a seed
+//! whose two boxes already lie in one grown combination is skipped: it grows into it): the
+//! boxes of a camera it lacks
 //! whose feet lie within `2·p_Th` of its projected feet are tried and the one with the lowest
 //! `E_c` is added while the combination stays valid (as in [`super::scalable`]). (3) The grown
 //! combinations are selected greedily by `E_c`, each box in at most one person — set packing,
