@@ -40,7 +40,8 @@
 //! **Association variants** ([`Association`]): `Paper` is the exhaustive search above;
 //! `Scalable` ([`scalable`]) builds new objects from pairwise-coherent head rays grown camera
 //! by camera and from box bottoms on the ground (single-camera people), with the same greedy
-//! selection by `E_c`.
+//! selection by `E_c`; `Ground` ([`ground`]) associates every frame on the ground plane from
+//! box feet and heads and tracks the people found by assignment on the ground.
 //!
 //! What it does not do: no appearance, no re-identification of discarded objects, no
 //! occlusion reasoning beyond what the combinations express.
@@ -52,6 +53,7 @@ use nalgebra::{Matrix4x6, Matrix6, Point2, Point3, SMatrix, Vector4, Vector6};
 use super::kalman::{Kalman, constant_velocity_2d};
 use crate::geometry::triangulate::{CalibratedView, triangulate_rays};
 
+mod ground;
 mod head;
 mod scalable;
 
@@ -91,6 +93,8 @@ pub enum Association {
     Paper,
     /// Pairwise ray seeds grown camera by camera, plus ground points ([`scalable`]).
     Scalable,
+    /// Per frame on the ground plane (feet and heads), then tracks by assignment ([`ground`]).
+    Ground,
 }
 
 /// Which error chooses between valid combinations.
@@ -204,6 +208,8 @@ struct Prepared {
     dir: nalgebra::Vector3<f64>,
     /// Where the ray through the box bottom meets the ground (z = 0).
     ground: Option<Point3<f64>>,
+    /// The box bottom in ideal pixels.
+    foot_ideal: Option<Point2<f64>>,
 }
 
 /// A valid combination: its support, triangulated head and errors.
@@ -349,6 +355,9 @@ impl CylinderTracker {
                     origin,
                     dir,
                     ground,
+                    foot_ideal: o
+                        .foot_px
+                        .and_then(|f| view.ideal_px(&Point2::new(f[0], f[1]))),
                 })
             })
             .collect();
@@ -556,13 +565,18 @@ impl CylinderTracker {
     /// Advance one frame with this frame's 2-D objects; returns every 3-D object alive after
     /// it (supported or coasting), sorted by id.
     pub fn step(&mut self, objects: &[Object2d]) -> (Vec<Cylinder>, StepStats) {
+        if self.params.association == Association::Ground {
+            return self.step_ground(objects);
+        }
         let mut stats = StepStats::default();
         let prepared = self.prepare(objects);
         let (f, q) = self.transition();
         let mut used = self.update_objects(&prepared, (&f, &q), &mut stats);
         let selected = match self.params.association {
             Association::Paper => self.select_new(&prepared, &mut used, &mut stats),
-            Association::Scalable => self.select_new_scalable(&prepared, &mut used, &mut stats),
+            Association::Scalable | Association::Ground => {
+                self.select_new_scalable(&prepared, &mut used, &mut stats)
+            }
         };
         self.continue_candidates(selected, (&f, &q), &mut stats);
         (self.cylinders(), stats)

@@ -82,13 +82,20 @@ pub struct Params {
     pub room_margin_m: f64,
     pub gate_m: f64,
     pub max_combinations: usize,
-    /// New 3-D objects: `paper` (exhaustive combinations) or `scalable` (pairwise ray seeds
-    /// grown camera by camera, plus single-camera ground points; `track::cylinders`).
+    /// New 3-D objects: `paper` (exhaustive combinations), `scalable` (pairwise ray seeds
+    /// grown camera by camera, plus single-camera ground points) or `ground` (per frame on
+    /// the ground plane from feet and heads, tracked by assignment; `track::cylinders`).
     pub association: Association,
     /// `scalable`: a single-camera ground point this close to a person already found is a
     /// view of that person (m).
     pub ground_separation_m: f64,
     // evaluation
+    /// Also run the configured association frame by frame without temporal tracking
+    /// (detector `<detector>_per_frame`) and write the `ghosts` and `splits` tables.
+    pub decompose: bool,
+    /// With `decompose`: `splits` scores frames before this one and from it on separately
+    /// (a development and a held-out part); 0 = no split.
+    pub split_frame: i64,
     /// CLEAR MOT / IDF1 matching thresholds on the ground (m).
     pub match_m: Vec<f64>,
     /// `N_app` values of the latency / false-alarm sweep (`N_dis = N_app`, as the paper).
@@ -146,6 +153,8 @@ impl Default for Params {
             max_combinations: 20_000,
             association: Association::Paper,
             ground_separation_m: 0.5,
+            decompose: false,
+            split_frame: 0,
             match_m: vec![0.5, 1.0],
             n_app_sweep: (1..=10).collect(),
             occluded_visibility: 0.8,

@@ -1,5 +1,5 @@
 //! The evaluation, one file per sub-experiment, each with its tables (and figures where it
-//! has one): `tracks`, `clear_mot` (CLEAR MOT / IDF1 / HOTA at each threshold), `moda` (MODA / MODP), `gt_boxes`
+//! has one): `tracks`, `clear_mot` (CLEAR MOT / IDF1 / HOTA at each threshold), `moda` (MODA / MODP), `decompose` (ghosts by cameras, development / held-out splits), `gt_boxes`
 //! (the 3-D stage on ground-truth boxes), `position` (position, height and radius errors),
 //! `sweep` (`N_app` against latency and false alarms), `head_centroid` (t-test),
 //! `selection` (E_c vs E_m), `stages` (per-camera image stages), `detections_2d` (the
@@ -7,6 +7,7 @@
 //! [`Scored`] sessions.
 
 mod clear_mot;
+mod decompose;
 mod detections_2d;
 mod gt_boxes;
 mod head_centroid;
@@ -30,6 +31,10 @@ pub(crate) fn evaluate(s: &Scored, p: &Params, products: &mut Products) -> anyho
     if s.has_truth() {
         products.tables.push(clear_mot::table(s, p)?);
         products.tables.push(moda::table(s)?);
+        if p.decompose {
+            products.tables.push(decompose::ghosts(s)?);
+            products.tables.push(decompose::splits(s, p)?);
+        }
         if let Some(t) = gt_boxes::table(s, &mut products.summary)? {
             products.tables.push(t);
         }

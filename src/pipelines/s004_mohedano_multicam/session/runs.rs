@@ -70,6 +70,35 @@ pub(crate) fn run_variant(
     Ok(out)
 }
 
+/// The configured association frame by frame: a fresh tracker with `N_app = N_dis = 1`
+/// every frame, so that nothing carries over (the 3-D association alone).
+pub(crate) fn run_per_frame(
+    views: &[CalibratedView],
+    params: CylinderParams,
+    frames: &[Vec<Object2d>],
+) -> anyhow::Result<VariantOut> {
+    let params = CylinderParams {
+        n_app: 1,
+        n_dis: 1,
+        ..params
+    };
+    let mut out = VariantOut {
+        tracks: Vec::with_capacity(frames.len()),
+        combinations: 0,
+        pruned_frames: 0,
+        promoted: 0,
+        discarded: 0,
+    };
+    for objs in frames {
+        let mut tracker = CylinderTracker::new(views.to_vec(), params)?;
+        let (cyl, stats) = tracker.step(objs);
+        out.combinations += stats.combinations;
+        out.pruned_frames += usize::from(stats.pruned);
+        out.tracks.push(cyl);
+    }
+    Ok(out)
+}
+
 /// `(source, selection, N_app)` of one run: the sweep over `N_app` (with the configured one)
 /// and the other selection rule at the configured `N_app`, per source.
 pub(crate) fn variants(p: &Params, sources: usize) -> Vec<(usize, Selection, u32)> {
@@ -138,9 +167,23 @@ pub(crate) fn run_all(
         .collect();
     let stamps: Vec<Nanos> = frames.iter().map(|f| f.stamp).collect();
     let mut rows = RunRows::default();
-    for (&(si, sel, n), r) in variants.iter().zip(results) {
+    let mut labelled: Vec<(String, Selection, u32, anyhow::Result<VariantOut>)> = variants
+        .iter()
+        .zip(results)
+        .map(|(&(si, sel, n), r)| (sources[si].0.to_string(), sel, n, r))
+        .collect();
+    if p.decompose {
+        let params = cylinder_params(p, dt_s, p.selection, p.n_app);
+        labelled.push((
+            format!("{}_per_frame", sources[0].0),
+            p.selection,
+            p.n_app,
+            run_per_frame(views, params, &sources[0].1),
+        ));
+    }
+    for (detector, sel, n, r) in labelled {
         let r = r?;
-        let (detector, selection) = (sources[si].0, selection_label(sel));
+        let (detector, selection) = (detector.as_str(), selection_label(sel));
         rows.variants.push(VariantRow {
             detector: detector.to_string(),
             selection: selection.to_string(),
