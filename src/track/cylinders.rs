@@ -53,6 +53,7 @@ use nalgebra::{Matrix4x6, Matrix6, Point2, Point3, SMatrix, Vector4, Vector6};
 use super::kalman::{Kalman, constant_velocity_2d};
 use crate::geometry::triangulate::{CalibratedView, triangulate_rays};
 
+mod candidate;
 mod ground;
 mod head;
 mod scalable;
@@ -726,39 +727,13 @@ impl CylinderTracker {
                 .map(|(j, c)| (support_difference(&c.support, &h.support), j))
                 .filter(|(d, _)| *d <= 1)
                 .min();
-            let cand = match best {
-                Some((_, j)) => {
-                    taken[j] = true;
-                    let mut c = old[j].clone();
-                    c.kf.predict(f, q);
-                    self.measure(&mut c.kf, &h);
-                    c.count += 1;
-                    c.support = h.support.clone();
-                    c.last = h;
-                    c
-                }
-                None => Candidate {
-                    support: h.support.clone(),
-                    count: 1,
-                    kf: self.new_filter(&h),
-                    last: h,
-                },
-            };
-            if cand.count >= self.params.n_app {
-                let id = self.next_id;
-                self.next_id += 1;
-                stats.promoted += 1;
-                self.objects.push(Object3d {
-                    id,
-                    kf: cand.kf,
-                    support: cand.support,
-                    misses: 0,
-                    age: 0,
-                    measured: Some(cand.last),
-                });
-            } else {
-                next.push(cand);
-            }
+            let prev = best.map(|(_, j)| {
+                taken[j] = true;
+                let mut c = old[j].clone();
+                c.kf.predict(f, q);
+                c
+            });
+            next.extend(self.advance_candidate(prev, h, stats));
         }
         self.candidates = next;
     }

@@ -48,6 +48,7 @@ mod reid_snapshots;
 mod roc;
 mod session;
 mod shared;
+mod snapshots;
 mod timing;
 mod wallflower;
 

@@ -20,8 +20,8 @@ use image::RgbImage;
 
 use super::local_tracks::TrackRow;
 use super::params::Params;
-use super::reid_snapshots::Snapshots;
 use super::shared::Frame;
+use super::snapshots::Snapshots;
 use crate::geometry::rect;
 use crate::report::rows::Rows;
 use crate::run::SessionTables;

@@ -1,10 +1,8 @@
 //! Re-identification, the paper's figs. 5–6 (seed 003 §V): "selected frames … each frame shows
 //! the estimated bounding box and estimated label of every detected person".
 //!
-//! The session stage keeps a few frames so that aggregation never re-opens the log: in every
-//! window of `snapshot_window_s` seconds, the frame with the most ground-truth person boxes
-//! (the earliest on a tie; windows without a person keep nothing), with the boxes of that
-//! frame — ground-truth local tracks and the system's own. The report then picks four of them
+//! The session stage keeps a few frames with their boxes (`snapshots`: per window of
+//! `snapshot_window_s` seconds, the frame with the most people). The report picks four of them
 //! per clip, evenly spread over the clip's snapshots that show a person of the clip, and draws
 //! each box with the label the paper's model (ADF) gave its local track in that clip: the top
 //! row on ground-truth local tracks (`#label (person p)`: the estimate beside the truth), the
@@ -13,122 +11,19 @@
 //! the second, as in the paper (clip 1: places lit alike; clip 2: across light).
 
 use image::RgbImage;
-use polars::prelude::Column;
 
 use super::params::{ClipParams, ReidParams};
 use super::reid::{FRAMES_TABLE, ReidFrameRow};
 use super::reid_report::{Method, Observation, in_clip, labels, observations};
+use super::snapshots::{BOXES_TABLE, IMAGE_PREFIX, SnapshotBox};
 use crate::report::Figure;
-use crate::report::columns::{i64s, image_table, read_image_table};
+use crate::report::columns::{i64s, read_image_table};
 use crate::report::figure::{FigureKind, ImageOverlay, Overlay};
 use crate::report::rows::Rows;
-use crate::run::{Aggregate, Products, SessionTables};
-use crate::table_row;
+use crate::run::{Aggregate, Products};
 
-/// Name of the cached table of every kept frame's boxes.
-const BOXES_TABLE: &str = "reid_snapshot_boxes";
-/// Prefix of the cached snapshot images, `reid_snapshot_0`, `_1`, ….
-const IMAGE_PREFIX: &str = "reid_snapshot_";
 /// Frames drawn per clip (the paper shows four).
 const PER_CLIP: usize = 4;
-
-table_row! {
-    /// One box of a kept frame.
-    #[derive(Debug, Clone, PartialEq)]
-    pub(super) struct SnapshotBox {
-        pub frame: i64,
-        pub t_s: f64,
-        /// `truth` or `system`, as in `reid_frames`.
-        pub source: String,
-        /// The person id (truth) or the track id (system).
-        pub id: i64,
-        pub x0: f64,
-        pub y0: f64,
-        pub x1: f64,
-        pub y1: f64,
-    }
-}
-
-/// A frame offered for keeping.
-struct Candidate {
-    window: i64,
-    frame: i64,
-    people: usize,
-    image: RgbImage,
-    boxes: Vec<SnapshotBox>,
-}
-
-/// The session side: the best frame of each window.
-pub(super) struct Snapshots {
-    window_s: f64,
-    best: Option<Candidate>,
-    kept: Vec<Candidate>,
-}
-
-impl Snapshots {
-    pub fn new(window_s: f64) -> Self {
-        Self {
-            window_s,
-            best: None,
-            kept: Vec::new(),
-        }
-    }
-
-    /// Offers frame `frame` at `t_s` with its boxes `(source, id, [x0, y0, x1, y1])`; the image
-    /// is copied only when the frame becomes its window's best.
-    pub fn offer(&mut self, frame: i64, t_s: f64, rgb: &RgbImage, boxes: &[(&str, i64, [f64; 4])]) {
-        let people = boxes.iter().filter(|b| b.0 == "truth").count();
-        if people == 0 || !t_s.is_finite() || self.window_s <= 0.0 {
-            return;
-        }
-        let window = (t_s / self.window_s).floor() as i64;
-        if self.best.as_ref().is_some_and(|b| b.window != window) {
-            self.kept.extend(self.best.take());
-        }
-        if self.best.as_ref().is_some_and(|b| b.people >= people) {
-            return;
-        }
-        let boxes = boxes
-            .iter()
-            .map(|&(source, id, b)| SnapshotBox {
-                frame,
-                t_s,
-                source: source.to_string(),
-                id,
-                x0: b[0],
-                y0: b[1],
-                x1: b[2],
-                y1: b[3],
-            })
-            .collect();
-        self.best = Some(Candidate {
-            window,
-            frame,
-            people,
-            image: rgb.clone(),
-            boxes,
-        });
-    }
-
-    /// The frames kept, in order.
-    fn frames(mut self) -> Vec<Candidate> {
-        self.kept.extend(self.best.take());
-        self.kept
-    }
-
-    /// The cached tables: every kept frame's boxes and images.
-    pub fn finish(self, out: &mut SessionTables) -> anyhow::Result<()> {
-        let kept = self.frames();
-        let boxes: Vec<SnapshotBox> = kept.iter().flat_map(|c| c.boxes.clone()).collect();
-        out.insert(BOXES_TABLE.into(), SnapshotBox::frame(&boxes)?);
-        for (k, c) in kept.iter().enumerate() {
-            let mut df = image_table(&c.image)?;
-            df.with_column(Column::new("frame".into(), [c.frame]))?;
-            out.insert(format!("{IMAGE_PREFIX}{k}"), df);
-        }
-        Ok(())
-    }
-}
 
 /// `n` of `len` indices spread evenly, first and last included (all of them when `len ≤ n`).
 pub(super) fn spread(len: usize, n: usize) -> Vec<usize> {
@@ -302,30 +197,5 @@ mod tests {
         assert_eq!(spread(10, 4), [0, 3, 6, 9]);
         assert_eq!(spread(5, 1), [0]);
         assert_eq!(spread(0, 4), Vec::<usize>::new());
-    }
-
-    #[test]
-    fn each_window_keeps_its_frame_with_the_most_people() {
-        let img = RgbImage::new(2, 2);
-        let one = [("truth", 1, [0.0, 0.0, 1.0, 1.0])];
-        let two = [
-            ("truth", 1, [0.0, 0.0, 1.0, 1.0]),
-            ("truth", 2, [0.0, 0.0, 1.0, 1.0]),
-            ("system", 9, [0.0, 0.0, 1.0, 1.0]),
-        ];
-        let none = [("system", 9, [0.0, 0.0, 1.0, 1.0])];
-        let mut s = Snapshots::new(10.0);
-        s.offer(0, 1.0, &img, &one);
-        s.offer(1, 2.0, &img, &two);
-        s.offer(2, 3.0, &img, &two); // a tie: the earlier frame stays
-        s.offer(3, 12.0, &img, &none); // no person: nothing kept
-        s.offer(4, 25.0, &img, &one);
-        s.offer(5, f64::NAN, &img, &two);
-        let kept: Vec<(i64, usize, usize)> = s
-            .frames()
-            .iter()
-            .map(|c| (c.frame, c.people, c.boxes.len()))
-            .collect();
-        assert_eq!(kept, [(1, 2, 3), (4, 1, 1)]);
     }
 }

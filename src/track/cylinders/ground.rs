@@ -45,8 +45,7 @@
 use nalgebra::{Matrix3, Point3, Vector3};
 
 use super::{
-    Candidate, Cylinder, CylinderTracker, Hypothesis, Object2d, Object3d, Prepared, StepStats,
-    cylinder_radius,
+    Cylinder, CylinderTracker, Hypothesis, Object2d, Prepared, StepStats, cylinder_radius,
 };
 use crate::assign::min_cost_max_pairs;
 
@@ -408,36 +407,9 @@ impl CylinderTracker {
             of_person[j] = Some(k);
         }
         for (h, k) in people.into_iter().zip(of_person) {
-            let cand = match k {
-                Some(k) => {
-                    let mut c = old[k].clone();
-                    self.measure(&mut c.kf, &h);
-                    c.count += 1;
-                    c.support = h.support.clone();
-                    c.last = h;
-                    c
-                }
-                None => Candidate {
-                    support: h.support.clone(),
-                    count: 1,
-                    kf: self.new_filter(&h),
-                    last: h,
-                },
-            };
-            if cand.count >= self.params.n_app {
-                let id = self.next_id;
-                self.next_id += 1;
-                stats.promoted += 1;
-                self.objects.push(Object3d {
-                    id,
-                    kf: cand.kf,
-                    support: cand.support,
-                    misses: 0,
-                    age: 0,
-                    measured: Some(cand.last),
-                });
-            } else {
-                self.candidates.push(cand);
+            let prev = k.map(|k| old[k].clone());
+            if let Some(c) = self.advance_candidate(prev, h, stats) {
+                self.candidates.push(c);
             }
         }
     }
