@@ -266,7 +266,8 @@ pub fn mean_shift(e: &Ellipse, pts: &[Point2<f64>]) -> Option<Point2<f64>> {
             sy += w * p.y;
             sw += w;
         }
-        if !(sw > 1e-12) {
+        // also catches a NaN sum
+        if sw.is_nan() || sw <= 1e-12 {
             return None;
         }
         let next = Point2::new(sx / sw, sy / sw);

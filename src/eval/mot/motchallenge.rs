@@ -83,10 +83,10 @@ pub fn parse_motchallenge(
             lines.push(line);
         }
     }
-    if has_duplicates(&out) {
-        if let Some(e) = duplicate_error(&out, &lines, path) {
-            return Err(e);
-        }
+    if has_duplicates(&out)
+        && let Some(e) = duplicate_error(&out, &lines, path)
+    {
+        return Err(e);
     }
     if kind == GeometryKind::Point && !out.is_empty() && !any_ground_plane {
         return Err(MotError::NoGroundPlane {
