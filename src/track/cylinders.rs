@@ -54,6 +54,7 @@ use super::kalman::{Kalman, constant_velocity_2d};
 use crate::geometry::triangulate::{CalibratedView, triangulate_rays};
 
 mod candidate;
+use candidate::select_disjoint;
 mod ground;
 mod head;
 mod scalable;
@@ -690,22 +691,11 @@ impl CylinderTracker {
         let free: Vec<usize> = (0..prepared.len()).filter(|&i| !used[i]).collect();
         let combos = self.combinations(prepared, &free, stats);
         stats.combinations += combos.len();
-        let mut valid: Vec<(f64, Vec<usize>, Hypothesis)> = combos
+        let valid: Vec<(f64, Vec<usize>, Hypothesis)> = combos
             .into_iter()
             .filter_map(|c| self.evaluate(prepared, &c).map(|h| (h.score(sel), c, h)))
             .collect();
-        valid.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let mut selected = Vec::new();
-        for (_, combo, h) in valid {
-            if combo.iter().any(|&i| used[i]) {
-                continue;
-            }
-            for &i in &combo {
-                used[i] = true;
-            }
-            selected.push(h);
-        }
-        selected
+        select_disjoint(valid, used)
     }
 
     /// Step 3: candidates are continued when this frame's selection differs in at most one

@@ -1,4 +1,5 @@
-//! Step 3's shared half: a hypothesis continues a candidate or starts one, and a candidate seen
+//! What the associations share: step 2's greedy selection of disjoint hypotheses, and step 3's
+//! half where a hypothesis continues a candidate or starts one, and a candidate seen
 //! in N_app frames becomes a person. The paper's search and the ground association differ only in
 //! how they pair candidates with this frame's hypotheses.
 
@@ -44,4 +45,25 @@ impl CylinderTracker {
         });
         None
     }
+}
+
+/// Greedy selection by score: hypotheses `(score, boxes, hypothesis)` taken best first (ties by
+/// their box lists), each kept only when none of its boxes is `used` yet, so every 2-D box
+/// supports at most one person; the boxes of the kept ones are marked `used`.
+pub(super) fn select_disjoint(
+    mut valid: Vec<(f64, Vec<usize>, Hypothesis)>,
+    used: &mut [bool],
+) -> Vec<Hypothesis> {
+    valid.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let mut selected = Vec::new();
+    for (_, combo, h) in valid {
+        if combo.iter().any(|&i| used[i]) {
+            continue;
+        }
+        for &i in &combo {
+            used[i] = true;
+        }
+        selected.push(h);
+    }
+    selected
 }

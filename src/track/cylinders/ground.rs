@@ -44,6 +44,7 @@
 
 use nalgebra::{Matrix3, Point3, Vector3};
 
+use super::candidate::select_disjoint;
 use super::{
     Cylinder, CylinderTracker, Hypothesis, Object2d, Prepared, StepStats, cylinder_radius,
 };
@@ -267,18 +268,8 @@ impl CylinderTracker {
                 valid.push((h.e_c, c, h));
             }
         }
-        valid.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let mut used = vec![false; prepared.len()];
-        let mut selected = Vec::new();
-        for (_, combo, h) in valid {
-            if combo.iter().any(|&i| used[i]) {
-                continue;
-            }
-            for &i in &combo {
-                used[i] = true;
-            }
-            selected.push(h);
-        }
+        let mut selected = select_disjoint(valid, &mut used);
         let multi = selected.len();
         for &i in usable.iter().filter(|&&i| !used[i]) {
             if self.explained(&prepared[i], &selected[..multi]) {

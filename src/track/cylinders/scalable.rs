@@ -41,6 +41,7 @@ use std::collections::BTreeSet;
 
 use nalgebra::Point3;
 
+use super::candidate::select_disjoint;
 use super::{CylinderTracker, Hypothesis, Prepared, StepStats, cylinder_radius};
 
 impl CylinderTracker {
@@ -153,17 +154,7 @@ impl CylinderTracker {
                 }
             }
         }
-        valid.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let mut selected = Vec::new();
-        for (_, combo, h) in valid {
-            if combo.iter().any(|&i| used[i]) {
-                continue;
-            }
-            for &i in &combo {
-                used[i] = true;
-            }
-            selected.push(h);
-        }
+        let mut selected = select_disjoint(valid, used);
         // ground points of what is left, best (lowest head reprojection error) first
         let mut singles: Vec<(f64, usize, Hypothesis)> = free
             .iter()
