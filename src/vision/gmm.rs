@@ -7,8 +7,10 @@
 //! 3 channels), sorted by descending weight. For each new sample x:
 //!
 //! - every component's weight follows eq. 14, `π ← (1 − α)π − αc_T (+ α if it owns x)`;
-//!   a component whose weight falls below `αc_T` after that step is dropped (the paper drops
-//!   it "when its weight becomes negative"; OpenCV, which we match, tests `< αc_T`);
+//!   a component whose weight falls below `αc_T` after that step is dropped (OpenCV's test,
+//!   [`Pruning::OpenCv`], the default); [`Pruning::Negative`] drops it, as the paper prints,
+//!   "when its weight π_m becomes negative" (below 0) — the kernel takes both rules, it only
+//!   changes the comparison's threshold;
 //! - the first component (in weight order) with squared Mahalanobis distance
 //!   `|x − µ|²/σ² < varThresholdGen` owns x: eq. 5–6 update its mean and variance with
 //!   `α/π`, the variance is clamped to `[fVarMin, fVarMax]`, and it moves up the weight order;
@@ -48,14 +50,15 @@
 //! Rows run in parallel with rayon; pixels never interact, so the masks are identical for
 //! any thread count. `make bench-gmm` measures frames/s beside OpenCV MOG2 on the same frames.
 //!
-//! **Saved state** ([`AdaptiveGmm::save`] / [`AdaptiveGmm::load`]; OpenCV cannot do this),
-//! all numbers little-endian:
+//! **Saved state** ([`AdaptiveGmm::save`] / [`AdaptiveGmm::load`] in `saved`; OpenCV cannot
+//! do this), all numbers little-endian:
 //!
 //! ```text
-//! magic    b"PTGMM\0", version u16 = 1
+//! magic    b"PTGMM\0", version u16 = 1 (OpenCV's pruning) or 2 (any other pruning rule)
 //! params   history u32, var_threshold f32, n_mixtures u32, background_ratio f32,
 //!          var_threshold_gen f32, var_init f32, var_min f32, var_max f32,
-//!          complexity_reduction f32, detect_shadows u8, shadow_threshold f32, shadow_value u8
+//!          complexity_reduction f32, detect_shadows u8, shadow_threshold f32, shadow_value u8,
+//!          version 2 only: pruning u8 (1 = Pruning::Negative)
 //! frames   frames seen u64 (the learning-rate schedule)
 //! shape    width u32, height u32, channels u8 (all 0 before the first frame)
 //! pixels   width*height records in row-major order: n u8 (≤ n_mixtures), then n components
@@ -67,11 +70,12 @@
 
 mod kernel;
 #[cfg(test)]
+mod pruning_tests;
+#[cfg(test)]
 mod reference;
+mod saved;
 #[cfg(test)]
 mod tests;
-
-use std::io::{Read, Write};
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -152,6 +156,19 @@ pub enum GmmError {
     Io(#[from] std::io::Error),
 }
 
+/// When eq. 14 drops a component that the data no longer support.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Pruning {
+    /// OpenCV MOG2's test: drop when the weight after eq. 14 is below `αc_T` (TOML `"opencv"`).
+    #[default]
+    #[serde(rename = "opencv")]
+    OpenCv,
+    /// The paper's sentence (Zivkovic 2004, section 4): "we discard the component m when its
+    /// weight π_m becomes negative", i.e. below 0 after eq. 14 (TOML `"negative"`).
+    Negative,
+}
+
 /// Parameters; [`Default`] gives OpenCV MOG2's defaults.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -180,6 +197,8 @@ pub struct GmmParams {
     pub shadow_threshold: f32,
     /// Mask value of a shadow pixel.
     pub shadow_value: u8,
+    /// When a component is dropped (OpenCV's rule by default).
+    pub pruning: Pruning,
 }
 
 impl Default for GmmParams {
@@ -197,6 +216,7 @@ impl Default for GmmParams {
             detect_shadows: true,
             shadow_threshold: DEFAULT_SHADOW_THRESHOLD,
             shadow_value: DEFAULT_SHADOW_VALUE,
+            pruning: Pruning::OpenCv,
         }
     }
 }
@@ -206,11 +226,24 @@ impl GmmParams {
     /// and OpenCV model it): a fixed budget of M = 4 components and no Dirichlet prior
     /// (c_T = 0), so no component is ever dropped; everything else as [`Default`].
     /// (The original ranks components by π/σ and uses a per-component learning rate; like
-    /// the paper, we keep the common update and change only M and c_T.)
+    /// the paper, we keep the common update and change only M and c_T. The original as
+    /// published is [`super::sg1999`].)
     pub fn stauffer_grimson() -> Self {
         Self {
             n_mixtures: 4,
             complexity_reduction: 0.0,
+            ..Self::default()
+        }
+    }
+
+    /// Zivkovic's model as the paper prints it (section 4): c_T = 0.01 ("at least
+    /// c = 0.01 · T samples support a component"), a component dropped when its weight
+    /// becomes negative ([`Pruning::Negative`]), T = 500. The paper states no largest number
+    /// of components: M = 5 is OpenCV's; everything else as [`Default`] (OpenCV's).
+    pub fn zivkovic_printed() -> Self {
+        Self {
+            complexity_reduction: 0.01,
+            pruning: Pruning::Negative,
             ..Self::default()
         }
     }
@@ -462,6 +495,10 @@ impl AdaptiveGmm {
             alpha: alpha_f,
             alpha1: 1.0 - alpha_f,
             prune: (-alpha * f64::from(p.complexity_reduction)) as f32,
+            drop_below: match p.pruning {
+                Pruning::OpenCv => -((-alpha * f64::from(p.complexity_reduction)) as f32),
+                Pruning::Negative => 0.0,
+            },
             tb: p.var_threshold,
             background_ratio: p.background_ratio,
             tg: p.var_threshold_gen,
@@ -577,193 +614,5 @@ impl AdaptiveGmm {
             }
         }
         Ok(out)
-    }
-
-    /// Write the whole model (parameters, frame count, every pixel's mixture) in the format
-    /// described in the module documentation.
-    pub fn save<W: Write>(&self, out: &mut W) -> Result<(), GmmError> {
-        let p = &self.params;
-        let mut head = Vec::with_capacity(64);
-        head.extend_from_slice(MAGIC);
-        head.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
-        head.extend_from_slice(&p.history.to_le_bytes());
-        head.extend_from_slice(&p.var_threshold.to_le_bytes());
-        head.extend_from_slice(&(p.n_mixtures as u32).to_le_bytes());
-        for v in [
-            p.background_ratio,
-            p.var_threshold_gen,
-            p.var_init,
-            p.var_min,
-            p.var_max,
-            p.complexity_reduction,
-        ] {
-            head.extend_from_slice(&v.to_le_bytes());
-        }
-        head.push(u8::from(p.detect_shadows));
-        head.extend_from_slice(&p.shadow_threshold.to_le_bytes());
-        head.push(p.shadow_value);
-        head.extend_from_slice(&self.frames.to_le_bytes());
-        let shape = self.shape.unwrap_or(Shape {
-            width: 0,
-            height: 0,
-            channels: 0,
-        });
-        head.extend_from_slice(&(shape.width as u32).to_le_bytes());
-        head.extend_from_slice(&(shape.height as u32).to_le_bytes());
-        head.push(shape.channels as u8);
-        out.write_all(&head)?;
-        let Some(shape) = self.shape else {
-            return Ok(());
-        };
-        let stride = 2 + shape.channels;
-        let mut buf = Vec::with_capacity(shape.width * (1 + 4 * stride * p.n_mixtures));
-        for y in 0..shape.height {
-            buf.clear();
-            for x in 0..shape.width {
-                let px = self.pixel_at(shape, x, y);
-                let n = self.count(px);
-                buf.push(n as u8);
-                for k in 0..n {
-                    for f in 0..stride {
-                        buf.extend_from_slice(&self.field(px, k, f).to_le_bytes());
-                    }
-                }
-            }
-            out.write_all(&buf)?;
-        }
-        Ok(())
-    }
-
-    /// Read a model written by [`Self::save`]. Every count and size is checked before use;
-    /// a corrupt or truncated input is an error, never a panic or a huge allocation.
-    pub fn load<R: Read>(input: &mut R) -> Result<Self, GmmError> {
-        let mut r = StateReader(input);
-        let mut magic = [0u8; 6];
-        r.bytes(&mut magic)?;
-        if &magic != MAGIC {
-            return Err(bad_state("not a peopletrack GMM state (bad magic)"));
-        }
-        let version = u16::from_le_bytes(r.array()?);
-        if version != FORMAT_VERSION {
-            return Err(bad_state(format!("format version {version} is not 1")));
-        }
-        let history = r.u32()?;
-        let var_threshold = r.f32()?;
-        let n_mixtures = r.u32()? as usize;
-        let [
-            background_ratio,
-            var_threshold_gen,
-            var_init,
-            var_min,
-            var_max,
-            complexity_reduction,
-        ] = [r.f32()?, r.f32()?, r.f32()?, r.f32()?, r.f32()?, r.f32()?];
-        let detect_shadows = match r.u8()? {
-            0 => false,
-            1 => true,
-            v => return Err(bad_state(format!("detect_shadows byte is {v}"))),
-        };
-        let shadow_threshold = r.f32()?;
-        let shadow_value = r.u8()?;
-        let params = GmmParams {
-            history,
-            var_threshold,
-            n_mixtures,
-            background_ratio,
-            var_threshold_gen,
-            var_init,
-            var_min,
-            var_max,
-            complexity_reduction,
-            detect_shadows,
-            shadow_threshold,
-            shadow_value,
-        };
-        let mut model = Self::new(params)?;
-        let frames = r.u64()?;
-        let (width, height, channels) = (r.u32()? as usize, r.u32()? as usize, r.u8()?);
-        if (width, height, channels) == (0, 0, 0) {
-            if frames != 0 {
-                return Err(bad_state("frames seen but no shape"));
-            }
-            return Ok(model);
-        }
-        if width == 0 || height == 0 || width * height > MAX_PIXELS {
-            return Err(bad_state(format!("implausible shape {width}x{height}")));
-        }
-        if channels != 1 && channels != 3 {
-            return Err(bad_state(format!("{channels} channels")));
-        }
-        let shape = Shape {
-            width,
-            height,
-            channels: usize::from(channels),
-        };
-        model.init(shape);
-        model.frames = frames;
-        let stride = 2 + shape.channels;
-        for y in 0..height {
-            for x in 0..width {
-                let px = model.pixel_at(shape, x, y);
-                let n = r.u8()?;
-                if usize::from(n) > n_mixtures {
-                    return Err(bad_state(format!(
-                        "pixel ({x}, {y}) has {n} components, more than {n_mixtures}"
-                    )));
-                }
-                model.modes[px.group][px.lane] = n;
-                for k in 0..usize::from(n) {
-                    for f in 0..stride {
-                        *model.field_mut(px, k, f) = r.f32()?;
-                    }
-                }
-            }
-        }
-        let mut extra = [0u8; 1];
-        if r.0.read(&mut extra)? != 0 {
-            return Err(bad_state("trailing bytes after the last pixel"));
-        }
-        Ok(model)
-    }
-}
-
-const MAGIC: &[u8; 6] = b"PTGMM\0";
-const FORMAT_VERSION: u16 = 1;
-/// Largest model [`AdaptiveGmm::load`] accepts (16384 × 16384 pixels).
-const MAX_PIXELS: usize = 1 << 28;
-
-fn bad_state(what: impl Into<String>) -> GmmError {
-    GmmError::BadState { what: what.into() }
-}
-
-/// Little-endian reads that turn a short input into [`GmmError::BadState`].
-struct StateReader<'a, R: Read>(&'a mut R);
-
-impl<R: Read> StateReader<'_, R> {
-    fn bytes(&mut self, buf: &mut [u8]) -> Result<(), GmmError> {
-        self.0.read_exact(buf).map_err(|e| {
-            if e.kind() == std::io::ErrorKind::UnexpectedEof {
-                bad_state("truncated")
-            } else {
-                GmmError::Io(e)
-            }
-        })
-    }
-    fn array<const N: usize>(&mut self) -> Result<[u8; N], GmmError> {
-        let mut b = [0u8; N];
-        self.bytes(&mut b)?;
-        Ok(b)
-    }
-    fn u8(&mut self) -> Result<u8, GmmError> {
-        Ok(self.array::<1>()?[0])
-    }
-    fn u32(&mut self) -> Result<u32, GmmError> {
-        Ok(u32::from_le_bytes(self.array()?))
-    }
-    fn u64(&mut self) -> Result<u64, GmmError> {
-        Ok(u64::from_le_bytes(self.array()?))
-    }
-    fn f32(&mut self) -> Result<f32, GmmError> {
-        Ok(f32::from_le_bytes(self.array()?))
     }
 }

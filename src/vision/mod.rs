@@ -49,10 +49,11 @@ pub mod local;
 pub mod moving;
 pub mod omni;
 pub mod score;
+pub mod sg1999;
 pub mod skin;
 pub mod synthetic;
 pub mod template;
 pub mod view;
 
-pub use gmm::{AdaptiveGmm, GmmError, GmmParams};
+pub use gmm::{AdaptiveGmm, GmmError, GmmParams, Pruning};
 pub use view::{ImageView, ViewError};

@@ -48,6 +48,9 @@ pub(super) struct Coeffs {
     pub alpha1: f32,
     /// `-α c_T`: the Dirichlet-prior term of eq. 14.
     pub prune: f32,
+    /// A component whose weight after eq. 14 is below this is dropped: `α c_T` (that is
+    /// `-prune`, OpenCV's test) or 0 (the paper's "becomes negative").
+    pub drop_below: f32,
     /// Foreground threshold on the squared Mahalanobis distance (`varThreshold`, c_thr).
     pub tb: f32,
     /// `1 - c_f` (`backgroundRatio`).
@@ -182,7 +185,7 @@ fn update_group<S: Simd, const C: usize>(
     let alpha = s.splat(co.alpha);
     let alpha1 = s.splat(co.alpha1);
     let prune = s.splat(co.prune);
-    let neg_prune = s.splat(-co.prune);
+    let drop_below = s.splat(co.drop_below);
     let tb = s.splat(co.tb);
     let tg = s.splat(co.tg);
     let big_tb = s.splat(co.background_ratio);
@@ -244,8 +247,9 @@ fn update_group<S: Simd, const C: usize>(
                 fits = s.or(fits, owner);
             }
         }
-        // Eq. 14's "drop the component when its weight goes negative", as OpenCV tests it.
-        let dropped = s.and(active, s.lt(w, neg_prune));
+        // Eq. 14's "drop the component when its weight goes negative": below α c_T as OpenCV
+        // tests it, or below 0 as printed (`Coeffs::drop_below`).
+        let dropped = s.and(active, s.lt(w, drop_below));
         let w_kept = s.select(dropped, zero, w);
         nm = s.sub(nm, s.select(dropped, one, zero));
         // Lanes where slot k is not in use get a meaningless value: a slot at or past a

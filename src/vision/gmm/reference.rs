@@ -6,7 +6,7 @@
 // Channel loops index several arrays at once, as the C++ they mirror does.
 #![allow(clippy::needless_range_loop)]
 
-use super::GmmParams;
+use super::{GmmParams, Pruning};
 
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct Slot {
@@ -56,6 +56,11 @@ impl ReferenceGmm {
         };
         // −α c_T: the Dirichlet-prior term of eq. 14.
         let prune = (-alpha * f64::from(self.params.complexity_reduction)) as f32;
+        // The drop threshold of eq. 14: α c_T (OpenCV) or 0 (the paper's "negative").
+        let drop_below = match self.params.pruning {
+            Pruning::OpenCv => -prune,
+            Pruning::Negative => 0.0,
+        };
         let alpha = alpha as f32;
         let c = self.channels;
         for p in 0..self.used.len() {
@@ -65,7 +70,7 @@ impl ReferenceGmm {
             }
             let frozen = learn.is_some_and(|l| !l[p]);
             let saved = frozen.then(|| (self.slots[p].clone(), self.used[p]));
-            mask[p] = self.pixel(p, &x, alpha, prune);
+            mask[p] = self.pixel(p, &x, alpha, prune, drop_below);
             if let Some((slots, used)) = saved {
                 self.slots[p] = slots;
                 self.used[p] = used;
@@ -73,7 +78,7 @@ impl ReferenceGmm {
         }
     }
 
-    fn pixel(&mut self, p: usize, x: &[f32; 3], alpha: f32, prune: f32) -> u8 {
+    fn pixel(&mut self, p: usize, x: &[f32; 3], alpha: f32, prune: f32, drop_below: f32) -> u8 {
         let pr = self.params;
         let c = self.channels;
         let var_min = pr.var_min.min(pr.var_max);
@@ -136,7 +141,7 @@ impl ReferenceGmm {
                 }
             }
             // Eq. 14: discard the component when its weight goes negative (OpenCV tests < α c_T).
-            if w < -prune {
+            if w < drop_below {
                 w = 0.0;
                 n -= 1;
             }

@@ -397,6 +397,16 @@ fn kernel_matches_scalar_reference_bit_for_bit() {
         (GmmParams::stauffer_grimson(), 3, Some(0.02)),
         (tight, 3, None),
         (tight, 1, Some(0.05)),
+        // the paper's pruning rule ("drop when negative") and c_T = 0.01
+        (GmmParams::zivkovic_printed(), 3, None),
+        (
+            GmmParams {
+                pruning: Pruning::Negative,
+                ..tight
+            },
+            1,
+            Some(0.05),
+        ),
         (
             GmmParams {
                 n_mixtures: 1,
