@@ -209,18 +209,30 @@ fn pipeline_end_to_end_on_a_tiny_scene() {
             .or_default()
             .push((num(thr), num(tp), num(fp)));
     }
-    assert_eq!(by_model.len(), 2, "{by_model:?}");
+    // the two models and, by default, the two printed variants ([[params.roc.extra]])
+    assert_eq!(by_model.len(), 4, "{by_model:?}");
     for (m, mut pts) in by_model {
         assert_eq!(pts.len(), 3);
         pts.sort_by(|x, y| x.0.total_cmp(&y.0));
         for w in pts.windows(2) {
             assert!(w[1].1 <= w[0].1 && w[1].2 <= w[0].2, "{m}: {pts:?}");
         }
-        assert!(
-            pts[0].1 > 30.0,
-            "{m}: the walker is mostly detected: {pts:?}"
-        );
+        // (Stauffer-Grimson as published starts wide, σ₀ = 30, and hardly adapts: not asked)
+        if !m.starts_with("Stauffer-Grimson 1999") {
+            assert!(
+                pts[0].1 > 30.0,
+                "{m}: the walker is mostly detected: {pts:?}"
+            );
+        }
     }
+    // roc_summary: one column per model
+    let summary = csv(&a, "roc_summary");
+    assert_eq!(
+        summary[0],
+        [
+            "dataset", "measure", "adaptive", "fixed_m4", "printed", "sg1999"
+        ]
+    );
 
     // colour trackers: four rows (HS/RGB x EM-like/mean shift)
     let ct = csv(&a, "colour_trackers");

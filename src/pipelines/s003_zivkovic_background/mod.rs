@@ -6,8 +6,9 @@
 //! - **ROC** (paper fig. 1), when the session has exact person masks and its dataset is not
 //!   in `roc.exclude_datasets` (static-background sequences such as the walker): the adaptive GMM
 //!   ([`GmmParams::default`], OpenCV MOG2's defaults) and the fixed-M baseline
-//!   ([`GmmParams::stauffer_grimson`], M = 4, c_T = 0) for every c_thr in
-//!   `roc.var_thresholds`; true positives (% of person pixels called foreground) and false
+//!   ([`GmmParams::stauffer_grimson`], M = 4, c_T = 0), and the `roc.extra` variants
+//!   (default: Zivkovic as printed, [`GmmParams::zivkovic_printed`], and Stauffer & Grimson
+//!   as published, `vision::sg1999`) for every c_thr in `roc.var_thresholds`; true positives (% of person pixels called foreground) and false
 //!   positives (% of other pixels called foreground), summed over the frames after
 //!   `roc.skip_frames`. Shadow pixels (127) count as background.
 //! - **Time per frame** (fig. 2, same sessions as the ROC) of both models at the default c_thr, each on one thread,
@@ -32,7 +33,7 @@
 //! [`crate::frames`] camera frames joined to ground truth and odometry, which hands each
 //! [`shared::Frame`] to one state struct per sub-experiment, and the `sessions` table),
 //! `shared` (the frame, the `session` row, grouping by dataset), one file per sub-experiment holding
-//! its per-frame state, cached tables, result tables and figures (`roc`, `timing`,
+//! its per-frame state, cached tables, result tables and figures (`roc` + `roc_report`, `timing`,
 //! `components`, `colour` + `colour_report`, `local_tracks`, `wallflower`).
 
 mod colour;
@@ -46,6 +47,7 @@ mod reid_figures;
 mod reid_report;
 mod reid_snapshots;
 mod roc;
+mod roc_report;
 mod session;
 mod shared;
 mod snapshots;
@@ -119,7 +121,7 @@ impl Experiment for BackgroundTracking {
     fn aggregate(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
         let mut products = Products::default();
         session::products(ctx, &mut products)?;
-        roc::products(ctx, p, &mut products)?;
+        roc_report::products(ctx, p, &mut products)?;
         timing::products(ctx, &mut products)?;
         components::products(ctx, &mut products)?;
         colour_report::products(ctx, p, &mut products)?;

@@ -12,6 +12,7 @@ use crate::vision::colortrack::{ColorSpace, ColorTrackError, EmParams, MeanShift
 use crate::vision::gmm::GmmError;
 use crate::vision::local::{LocalError, LocalParams};
 use crate::vision::moving::MovingParams;
+use crate::vision::sg1999::Sg1999Params;
 
 /// `[params.roc]`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -30,6 +31,102 @@ pub struct RocParams {
     /// Datasets with exact masks that are *not* ROC / timing / components scenes (e.g. the
     /// static-background walker sequence of the colour-tracker comparison).
     pub exclude_datasets: Vec<String>,
+    /// More models scored beside the two (`[[params.roc.extra]]`): rows of `roc`, columns
+    /// of `roc_summary` (not timed).
+    pub extra: Vec<RocVariant>,
+}
+
+/// One more ROC model (`[[params.roc.extra]]`): a `name` (its `roc_summary` column), a
+/// `label` (its `model` in `roc` and the figures) and exactly one model table — `gmm`
+/// (Zivkovic's model / OpenCV MOG2 with any parameters, `var_threshold` swept) or `sg1999`
+/// (Stauffer & Grimson as published, `vision::sg1999`; its Mahalanobis threshold swept).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RocVariant {
+    pub name: String,
+    pub label: String,
+    #[serde(default)]
+    pub gmm: Option<GmmParams>,
+    #[serde(default)]
+    pub sg1999: Option<Sg1999Params>,
+}
+
+impl RocVariant {
+    /// The two printed models of seed 003's comparison (README, "Which GMM each table uses").
+    pub fn printed() -> Vec<Self> {
+        vec![
+            Self {
+                name: "printed".into(),
+                label: "adaptive GMM as printed (c_T = 0.01; dropped when negative)".into(),
+                gmm: Some(GmmParams::zivkovic_printed()),
+                sg1999: None,
+            },
+            Self {
+                name: "sg1999".into(),
+                label: "Stauffer-Grimson 1999 as published (omega/sigma ranking; rho = alpha eta)"
+                    .into(),
+                gmm: None,
+                sg1999: Some(Sg1999Params::default()),
+            },
+        ]
+    }
+}
+
+/// Columns of `roc_summary` besides the variants' names.
+const SUMMARY_COLUMNS: [&str; 4] = ["dataset", "measure", "adaptive", "fixed_m4"];
+
+/// The `[[params.roc.extra]]` entries: a unique column-safe name, a label unlike the two
+/// models', exactly one model table, valid model parameters.
+fn validate_extra(roc: &RocParams, bad: &mut impl FnMut(&str, String)) {
+    let mut seen = std::collections::BTreeSet::new();
+    for (i, v) in roc.extra.iter().enumerate() {
+        let key = format!("roc.extra[{i}]");
+        let safe = !v.name.is_empty()
+            && v.name
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+        if !safe || SUMMARY_COLUMNS.contains(&v.name.as_str()) {
+            bad(
+                &format!("{key}.name"),
+                format!(
+                    "`{}` must be lowercase letters, digits and _ and not one of {SUMMARY_COLUMNS:?}",
+                    v.name
+                ),
+            );
+        }
+        if !seen.insert(v.name.clone()) {
+            bad(
+                &format!("{key}.name"),
+                format!("`{}` is used twice", v.name),
+            );
+        }
+        if v.label.trim().is_empty()
+            || [model_name(true), model_name(false)].contains(&v.label.as_str())
+        {
+            bad(
+                &format!("{key}.label"),
+                format!(
+                    "`{}` must be non-empty and unlike the two models' labels",
+                    v.label
+                ),
+            );
+        }
+        let problem = match (&v.gmm, &v.sg1999) {
+            (Some(g), None) => g.validate().err().map(|e| gmm_problem(&format!("{key}.gmm"), &e)),
+            (None, Some(sg)) => sg
+                .validate()
+                .err()
+                .map(|e| gmm_problem(&format!("{key}.sg1999"), &e)),
+            _ => Some((
+                key.clone(),
+                "needs exactly one model table: [params.roc.extra.gmm] or [params.roc.extra.sg1999]"
+                    .into(),
+            )),
+        };
+        if let Some((k, r)) = problem {
+            bad(&k, r);
+        }
+    }
 }
 
 impl Default for RocParams {
@@ -41,6 +138,7 @@ impl Default for RocParams {
             baseline: GmmParams::stauffer_grimson(),
             fp_at_pct: vec![0.5, 1.0, 2.0],
             exclude_datasets: Vec::new(),
+            extra: RocVariant::printed(),
         }
     }
 }
@@ -466,6 +564,7 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
             bad(key, format!("{v} must be finite and non-negative"));
         }
     }
+    validate_extra(&p.roc, &mut bad);
     validate_reid(&p.reid, &mut bad);
     validate_moving(&p.moving, &mut bad);
     if p.roc.fp_at_pct.iter().any(|v| !(0.0..=100.0).contains(v)) {
@@ -524,6 +623,56 @@ mod tests {
         m.moving.ransac_threshold_px = f64::INFINITY;
         let names: Vec<String> = validate(&m).into_iter().map(|(n, _)| n).collect();
         assert_eq!(names, ["moving.ransac_threshold_px", "moving.corners"]);
+    }
+
+    #[test]
+    fn extra_roc_models_are_checked_and_named() {
+        let mut p = Params::default();
+        assert_eq!(p.roc.extra.len(), 2);
+        p.roc.extra[0].name = "fixed_m4".into();
+        p.roc.extra[1].name = "Bad Name".into();
+        p.roc.extra[1].sg1999 = Some(Sg1999Params {
+            k: 0,
+            ..Sg1999Params::default()
+        });
+        let mut both = RocVariant::printed().remove(1);
+        both.name = "both".into();
+        both.gmm = Some(GmmParams::default());
+        let mut twice = RocVariant::printed().remove(0);
+        twice.label = model_name(true).into();
+        p.roc.extra.push(both);
+        p.roc.extra.push(twice);
+        let names: Vec<String> = validate(&p).into_iter().map(|(n, _)| n).collect();
+        assert_eq!(
+            names,
+            [
+                "roc.extra[0].name",
+                "roc.extra[1].name",
+                "roc.extra[1].sg1999.k",
+                "roc.extra[2]",
+                "roc.extra[3].label"
+            ]
+        );
+        // and from TOML: a model table the variant does not know is a clear error
+        let ok: RocParams = toml::from_str(
+            "[[extra]]\nname = \"p\"\nlabel = \"P\"\n[extra.gmm]\ncomplexity_reduction = 0.01\npruning = \"negative\"\n",
+        )
+        .expect("parses");
+        assert_eq!(
+            ok.extra[0].gmm.map(|g| g.pruning),
+            Some(crate::vision::Pruning::Negative)
+        );
+        let err =
+            toml::from_str::<RocParams>("[[extra]]\nname = \"p\"\nlabel = \"P\"\n[extra.mog]\n")
+                .expect_err("unknown table")
+                .to_string();
+        assert!(err.contains("unknown field `mog`"), "{err}");
+        let err = toml::from_str::<RocParams>(
+            "[[extra]]\nname = \"p\"\nlabel = \"P\"\n[extra.gmm]\npruning = \"never\"\n",
+        )
+        .expect_err("unknown rule")
+        .to_string();
+        assert!(err.contains("unknown variant `never`"), "{err}");
     }
 
     #[test]
