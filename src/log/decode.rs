@@ -15,6 +15,7 @@
 //! 2 name, or by one of its Foxglove equivalents) before converting.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::Arc;
 
 use prost_reflect::MessageDescriptor;
@@ -110,10 +111,33 @@ impl Entry {
     }
 }
 
+/// A multiplicative hash of the channel id (Fibonacci hashing: the high bits, which the
+/// table also reads, vary too): the map is looked up once per message, and its keys are a
+/// log's channel ids, where a keyed hash buys nothing.
+#[derive(Default)]
+struct ChannelIdHasher(u64);
+
+/// 2^64 / φ, odd.
+const FIBONACCI: u64 = 0x9e37_79b9_7f4a_7c15;
+
+impl Hasher for ChannelIdHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0.rotate_left(8) ^ u64::from(b)).wrapping_mul(FIBONACCI);
+        }
+    }
+    fn write_u16(&mut self, v: u16) {
+        self.0 = u64::from(v).wrapping_mul(FIBONACCI);
+    }
+}
+
 /// Decoders per channel, built on first use. One per reading thread.
 #[derive(Debug, Default)]
 pub struct Decoders {
-    by_channel: HashMap<u16, Entry>,
+    by_channel: HashMap<u16, Entry, BuildHasherDefault<ChannelIdHasher>>,
     /// Reused buffers of [`Decoders::decode`].
     scratch: Scratch,
     /// Float texts reused by [`Decoders::write_json`].

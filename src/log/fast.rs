@@ -194,23 +194,45 @@ pub enum Decoded<'s, 'm> {
     Value(super::value::Value),
 }
 
-/// Reused buffers for [`Decoded`]: one message of each buffered kind.
+/// Reused buffers for [`Decoded`]: one message of each buffered kind, and of TF one per
+/// transform count. A log's TF publishers each send their own fixed set of frames (one
+/// odometry transform; nineteen static mounts; four wheels), interleaved: a buffer per count
+/// keeps each set's frame-id strings, which the next message of that set then only compares
+/// ([`Cursor::string_into`]) instead of freeing, allocating and copying them.
 #[derive(Debug, Default)]
 pub struct Scratch {
-    tf: TfMessage,
+    tf: Vec<TfMessage>,
     odometry: Odometry,
     imu: Imu,
     scan: LaserScan,
     camera_info: CameraInfo,
 }
 
+/// TF buffers a [`Scratch`] keeps (distinct transform counts; beyond, the first is reused).
+const TF_BUFFERS: usize = 8;
+
 impl Scratch {
     /// Decode a payload of a channel whose fast kind is `kind`.
     pub fn decode<'s, 'm>(&'s mut self, kind: FastKind, data: &'m [u8]) -> Result<Decoded<'s, 'm>> {
         Ok(match kind {
             FastKind::Tf => {
-                decode_into(data, &mut self.tf)?;
-                Decoded::Tf(&self.tf)
+                // the transform count leads the payload; a short one is left to the decoder
+                // to report
+                let n = Cursor::new(data).and_then(|mut c| c.u32()).unwrap_or(0);
+                let k = match self
+                    .tf
+                    .iter()
+                    .position(|t| t.transforms.len() == n as usize)
+                {
+                    Some(k) => k,
+                    None if self.tf.len() < TF_BUFFERS => {
+                        self.tf.push(TfMessage::default());
+                        self.tf.len() - 1
+                    }
+                    None => 0,
+                };
+                decode_into(data, &mut self.tf[k])?;
+                Decoded::Tf(&self.tf[k])
             }
             FastKind::Odometry => {
                 decode_into(data, &mut self.odometry)?;

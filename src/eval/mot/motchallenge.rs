@@ -47,10 +47,8 @@ pub fn parse_motchallenge(
         GeometryKind::Box => 6,
         GeometryKind::Point => 9,
     };
-    // A rough row count, to grow the tables once or twice rather than a dozen times.
-    let rows_guess = text.len() / 48;
-    let mut out = Vec::with_capacity(rows_guess);
-    let mut lines = Vec::with_capacity(rows_guess);
+    // A rough row count, to grow the table once or twice rather than a dozen times.
+    let mut out = Vec::with_capacity(text.len() / 48);
     let mut any_ground_plane = false;
     let bytes = text.as_bytes();
     let (mut pos, mut line) = (0, 0);
@@ -71,7 +69,7 @@ pub fn parse_motchallenge(
                 match parse_row(raw.strip_suffix('\r').unwrap_or(raw), path, line, kind) {
                     Ok(o) => o,
                     // A duplicate on an earlier line is the first error in the file.
-                    Err(e) => return Err(duplicate_error(&out, &lines, path).unwrap_or(e)),
+                    Err(e) => return Err(duplicate_error(&out, text, path).unwrap_or(e)),
                 }
             }
         };
@@ -80,11 +78,10 @@ pub fn parse_motchallenge(
                 any_ground_plane |= !(p.x_m == -1.0 && p.y_m == -1.0);
             }
             out.push(o);
-            lines.push(line);
         }
     }
     if has_duplicates(&out)
-        && let Some(e) = duplicate_error(&out, &lines, path)
+        && let Some(e) = duplicate_error(&out, text, path)
     {
         return Err(e);
     }
@@ -295,6 +292,10 @@ fn has_duplicates(rows: &[Observation]) -> bool {
     let mut ids: Vec<i64> = Vec::new();
     if rows.is_sorted_by_key(|o| o.frame) {
         rows.chunk_by(|a, b| a.frame == b.frame).any(|run| {
+            // ids written in ascending order (as most writers do) cannot repeat
+            if run.is_sorted_by(|a, b| a.id < b.id) {
+                return false;
+            }
             ids.clear();
             ids.extend(run.iter().map(|o| o.id));
             ids.sort_unstable();
@@ -307,10 +308,20 @@ fn has_duplicates(rows: &[Observation]) -> bool {
     }
 }
 
-/// The first line (in file order) that repeats an earlier row's (frame, id), if any.
-fn duplicate_error(rows: &[Observation], lines: &[usize], path: &Path) -> Option<MotError> {
+/// The 1-based lines of the rows of `text`: its lines that are not blank (every other line
+/// is a row or an error), found again only when an error needs them.
+fn row_lines(text: &str) -> impl Iterator<Item = usize> + '_ {
+    text.split('\n')
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(k, _)| k + 1)
+}
+
+/// The first line (in file order) that repeats an earlier row's (frame, id), if any, among
+/// `rows`, the first rows of `text`.
+fn duplicate_error(rows: &[Observation], text: &str, path: &Path) -> Option<MotError> {
     let mut first_line: HashMap<(i64, i64), usize> = HashMap::with_capacity(rows.len());
-    for (o, &line) in rows.iter().zip(lines) {
+    for (o, line) in rows.iter().zip(row_lines(text)) {
         if let Some(&first) = first_line.get(&(o.frame, o.id)) {
             return Some(MotError::DuplicateRow {
                 path: path.to_path_buf(),

@@ -187,15 +187,25 @@ fn push_allowed(out: &mut Vec<Pair>, i: usize, j: usize, dist: f64) {
     }
 }
 
-/// One frame's hypothesis boxes sorted by left edge, to find the boxes that overlap one
-/// ground-truth box without testing them all: a box can overlap only if its left edge is
-/// left of the ground truth's right edge (a prefix of the order) and if some box at or
-/// before it in the order reaches past the ground truth's left edge (the running maximum
-/// of right edges, non-decreasing, gives where that starts). Both ends are found by binary
-/// search with exact comparisons; each box between them is then tested exactly.
+/// One frame's hypothesis boxes, loaded to find the boxes that overlap one ground-truth box.
+///
+/// A frame of at most [`COLUMN_SCAN_MAX`] boxes keeps its boxes of positive width and height
+/// as `[left, top, right, bottom]` rows in index order and tests each against the ground
+/// truth with four comparisons and no branch until a hit: for a few dozen people a frame is
+/// tested faster so than by the search below, and hits come out ascending.
+///
+/// A larger frame is sorted by left edge, to skip most boxes: a box can overlap only if its
+/// left edge is left of the ground truth's right edge (a prefix of the order) and if some
+/// box at or before it in the order reaches past the ground truth's left edge (the running
+/// maximum of right edges, non-decreasing, gives where that starts). Both ends are found by
+/// binary search with exact comparisons; each box between them is then tested exactly.
 #[derive(Debug, Default)]
 struct Overlaps {
-    /// Hypothesis indices by left edge.
+    /// Column mode: the boxes of positive width and height as `[left, top, right, bottom]`,
+    /// and their indices.
+    rows: Vec<[f64; 4]>,
+    row_index: Vec<u32>,
+    /// Sweep mode (`order` empty in column mode): hypothesis indices by left edge.
     order: Vec<u32>,
     left: Vec<f64>,
     /// Running maximum of the right edges, in `order`.
@@ -207,6 +217,17 @@ struct Overlaps {
 impl Overlaps {
     fn load(&mut self, boxes: &[Prepared]) {
         self.order.clear();
+        self.rows.clear();
+        self.row_index.clear();
+        if boxes.len() <= COLUMN_SCAN_MAX {
+            for (k, &[l, t, r, b, _]) in boxes.iter().enumerate() {
+                if r > l && b > t {
+                    self.rows.push([l, t, r, b]);
+                    self.row_index.push(k as u32);
+                }
+            }
+            return;
+        }
         self.order.extend(0..boxes.len() as u32);
         self.order
             .sort_unstable_by(|&a, &b| boxes[a as usize][0].total_cmp(&boxes[b as usize][0]));
@@ -231,6 +252,15 @@ impl Overlaps {
         if !(ar > al && ab > at) {
             return;
         }
+        if self.order.is_empty() {
+            for (&[l, t, r, b], &k) in self.rows.iter().zip(&self.row_index) {
+                // `&`, not `&&`: all four comparisons, no branch per comparison
+                if (l < ar) & (r > al) & (t < ab) & (b > at) {
+                    self.hits.push(k);
+                }
+            }
+            return;
+        }
         let end = self.left.partition_point(|&l| l < ar);
         let start = self.reach[..end].partition_point(|&r| r <= al);
         for &k in &self.order[start..end] {
@@ -242,6 +272,9 @@ impl Overlaps {
         self.hits.sort_unstable();
     }
 }
+
+/// Hypotheses in a frame up to which [`Overlaps`] tests every box rather than searching.
+const COLUMN_SCAN_MAX: usize = 64;
 
 /// Allowed pairs per observation up to which a [`Sequence`] keeps them all (CLEAR MOT and
 /// IDF1 both read them); beyond it (a gate that lets most pairs through) they are found
@@ -586,18 +619,23 @@ mod tests {
                 })));
             }
         }
-        let mut o = Overlaps::default();
-        o.load(&boxes);
-        let mut hits = 0;
-        for a in &boxes {
-            o.test(a, &boxes);
-            let want: Vec<u32> = (0..boxes.len() as u32)
-                .filter(|&k| overlaps(a, &boxes[k as usize]))
-                .collect();
-            assert_eq!(o.hits, want, "{a:?}");
-            hits += want.len();
+        // 40 boxes are scanned as columns, the same twice over (80) by the sorted sweep
+        let twice = [boxes.clone(), boxes].concat();
+        for (boxes, column_mode) in [(&twice[..40], true), (&twice[..], false)] {
+            let mut o = Overlaps::default();
+            o.load(boxes);
+            assert_eq!(o.order.is_empty(), column_mode);
+            let mut hits = 0;
+            for a in boxes {
+                o.test(a, boxes);
+                let want: Vec<u32> = (0..boxes.len() as u32)
+                    .filter(|&k| overlaps(a, &boxes[k as usize]))
+                    .collect();
+                assert_eq!(o.hits, want, "{a:?}");
+                hits += want.len();
+            }
+            assert!(hits > 50 && hits < boxes.len() * boxes.len() / 2, "{hits}");
         }
-        assert!(hits > 50 && hits < boxes.len() * boxes.len() / 2, "{hits}");
     }
 
     #[test]

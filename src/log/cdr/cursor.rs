@@ -131,9 +131,13 @@ impl<'a> Cursor<'a> {
         Ok(String::from_utf8_lossy(self.str_bytes()?))
     }
 
-    /// A string into `out`, reusing its buffer.
+    /// A string into `out`, reusing its buffer (untouched when it already holds these bytes,
+    /// as a frame id read message after message does).
     pub fn string_into(&mut self, out: &mut String) -> Result<()> {
         let b = self.str_bytes()?;
+        if out.as_bytes() == b {
+            return Ok(());
+        }
         out.clear();
         match std::str::from_utf8(b) {
             Ok(s) => out.push_str(s),
@@ -219,12 +223,40 @@ impl<'a> Cursor<'a> {
     }
 
     /// Three `float64` (a `Point` or `Vector3`).
+    #[inline]
     pub fn xyz(&mut self) -> Result<[f64; 3]> {
-        Ok([self.f64()?, self.f64()?, self.f64()?])
+        match self.f64s::<3>() {
+            Some(v) => Ok(v),
+            None => Ok([self.f64()?, self.f64()?, self.f64()?]),
+        }
     }
 
     /// `geometry_msgs/msg/Quaternion` as `[x, y, z, w]`.
+    #[inline]
     pub fn xyzw(&mut self) -> Result<[f64; 4]> {
-        Ok([self.f64()?, self.f64()?, self.f64()?, self.f64()?])
+        match self.f64s::<4>() {
+            Some(v) => Ok(v),
+            None => Ok([self.f64()?, self.f64()?, self.f64()?, self.f64()?]),
+        }
+    }
+
+    /// `N` consecutive `float64` fields when the payload has them all (one alignment: after
+    /// the first each is aligned already), else `None` with the cursor unmoved, for the
+    /// field-by-field reads to name what is missing.
+    #[inline]
+    fn f64s<const N: usize>(&mut self) -> Option<[f64; N]> {
+        let a = 8.min(self.max_align);
+        let start = self.pos.next_multiple_of(a);
+        let bytes = self.buf.get(start..)?.get(..8 * N)?;
+        let mut out = [0.0; N];
+        for (o, &b) in out.iter_mut().zip(bytes.as_chunks::<8>().0) {
+            *o = if self.big {
+                f64::from_be_bytes(b)
+            } else {
+                f64::from_le_bytes(b)
+            };
+        }
+        self.pos = start + 8 * N;
+        Some(out)
     }
 }

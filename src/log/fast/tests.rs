@@ -305,6 +305,37 @@ fn reused_buffers_give_the_same_message_as_a_fresh_decode() {
 }
 
 #[test]
+fn scratch_tf_buffers_per_count_give_each_message_as_a_fresh_decode() {
+    // sets of 3 and 1 transforms interleaved; a set of 3 with other names (one of them
+    // invalid UTF-8, one the very text its lossy reading gives) shares the 3-buffer
+    let tf = |names: &[&[u8]]| {
+        let mut w = W::new(false, 8);
+        w.u32(names.len() as u32);
+        for (i, name) in names.iter().enumerate() {
+            w.header(i as i32, 7, name).str(b"child");
+            w.f64s(&[i as f64 + 0.5; 7]);
+        }
+        w.buf
+    };
+    let three = tf(&[b"odom", b"base_link", b"laser"]);
+    let one = tf(&[b"map"]);
+    let other = tf(&[b"odom", &[b'a', 0xff, b'b'], "a\u{fffd}b".as_bytes()]);
+    let lossy = tf(&[b"odom", "a\u{fffd}b".as_bytes(), &[b'a', 0xff, b'b']]);
+    let mut scratch = Scratch::default();
+    for data in [&three, &one, &three, &other, &lossy, &one, &three, &lossy] {
+        let want = decode::<TfMessage>(data).expect("decodes");
+        match scratch.decode(FastKind::Tf, data).expect("decodes") {
+            Decoded::Tf(got) => assert_eq!(got, &want),
+            d => panic!("{d:?}"),
+        }
+    }
+    assert_eq!(scratch.tf.len(), 2, "one buffer per transform count");
+    let short = &three[..three.len() - 1];
+    assert!(scratch.decode(FastKind::Tf, short).is_err());
+    assert!(scratch.decode(FastKind::Tf, &three[..2]).is_err());
+}
+
+#[test]
 fn decode_as_gives_only_the_kinds_own_type() {
     let mut w = W::new(false, 8);
     w.header(1, 2, b"cam").str(b"png").u32(1).u8(9);

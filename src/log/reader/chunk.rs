@@ -127,7 +127,7 @@ const BULK_MAX_BYTES: u64 = 64 << 20;
 /// streaming path then reads it and says what is wrong).
 fn zstd_whole(src: &[u8], want: u64) -> Option<Vec<u8>> {
     let want = usize::try_from(want).ok()?;
-    let mut out = Vec::with_capacity(want);
+    let mut out = pooled_buffer(want);
     let n = ZSTD.with(|d| {
         let mut d = d.try_borrow_mut().ok()?;
         if d.is_none() {
@@ -138,7 +138,56 @@ fn zstd_whole(src: &[u8], want: u64) -> Option<Vec<u8>> {
     (n == want).then_some(out)
 }
 
+/// Decompressed chunk bytes shared by the messages borrowed from them. When the last
+/// reference goes, the buffer returns to the dropping thread's pool (see [`pooled_buffer`]),
+/// so a read does not take fresh pages from the system, and fault them in, for every chunk.
+pub(super) struct ChunkBuf(pub(super) Vec<u8>);
+
+impl std::ops::Deref for ChunkBuf {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        &self.0
+    }
+}
+
+impl Drop for ChunkBuf {
+    fn drop(&mut self) {
+        let buf = std::mem::take(&mut self.0);
+        if (POOL_MIN_BYTES..=POOL_MAX_BYTES).contains(&buf.capacity()) {
+            // a thread being torn down has no pool left: the buffer is simply freed
+            let _ = POOL.try_with(|p| {
+                if let Ok(mut p) = p.try_borrow_mut()
+                    && p.len() < POOL_MAX_BUFFERS
+                {
+                    p.push(buf);
+                }
+            });
+        }
+    }
+}
+
+/// Buffers a thread keeps for its next chunks, and the sizes it keeps: memory held beyond
+/// the chunks in use stays at most 2 × 8 MiB (real chunks are 1 to 4 MiB; single message
+/// records outside chunks are not worth keeping).
+const POOL_MAX_BUFFERS: usize = 2;
+const POOL_MIN_BYTES: usize = 64 << 10;
+const POOL_MAX_BYTES: usize = 8 << 20;
+
+/// An empty buffer with room for `capacity` bytes, from this thread's pool when it has one.
+fn pooled_buffer(capacity: usize) -> Vec<u8> {
+    let mut buf = POOL
+        .try_with(|p| p.try_borrow_mut().ok().and_then(|mut p| p.pop()))
+        .ok()
+        .flatten()
+        .unwrap_or_default();
+    buf.clear();
+    buf.reserve(capacity);
+    buf
+}
+
 thread_local! {
+    /// Freed chunk buffers, reused by [`pooled_buffer`].
+    static POOL: RefCell<Vec<Vec<u8>>> = const { RefCell::new(Vec::new()) };
     /// One zstd decompression context per thread, reused from chunk to chunk.
     static ZSTD: RefCell<Option<zstd::bulk::Decompressor<'static>>> = const { RefCell::new(None) };
 }

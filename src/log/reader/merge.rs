@@ -18,7 +18,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use super::super::error::{LogError, LogErrorKind};
-use super::chunk::{Keep, open_chunk_keeping};
+use super::chunk::{ChunkBuf, Keep, open_chunk_keeping};
 use super::index::LogSummary;
 use super::io::read_at;
 use super::records::{
@@ -30,7 +30,7 @@ use crate::time::Nanos;
 /// Message bytes, borrowed from a decompressed chunk kept alive by reference counting.
 #[derive(Clone)]
 pub struct Payload {
-    buf: Arc<Vec<u8>>,
+    buf: Arc<ChunkBuf>,
     start: usize,
     end: usize,
 }
@@ -66,7 +66,7 @@ impl Message {
 
 /// A decompressed chunk and the messages still to yield from it.
 struct Slot {
-    buf: Arc<Vec<u8>>,
+    buf: Arc<ChunkBuf>,
     /// `(log_time, offset of the message record in buf)`, sorted.
     entries: Vec<(u64, u32)>,
     next: usize,
@@ -139,7 +139,7 @@ impl Catalog {
         }
         entries.sort_unstable();
         Ok(Slot {
-            buf: Arc::new(data),
+            buf: Arc::new(ChunkBuf(data)),
             entries,
             next: 0,
             chunk_offset,
@@ -150,7 +150,7 @@ impl Catalog {
     /// errors name).
     fn message_at(
         &self,
-        buf: &Arc<Vec<u8>>,
+        buf: &Arc<ChunkBuf>,
         at: usize,
         where_: u64,
     ) -> Result<Message, LogErrorKind> {
@@ -248,7 +248,7 @@ impl ChunkMerge {
 
     /// The next message's chunk buffer, record offset and chunk offset; a chunk's slot is
     /// freed with its last message (its buffer lives on while the caller holds a payload).
-    fn pop(&mut self) -> Option<(Arc<Vec<u8>>, u32, u64)> {
+    fn pop(&mut self) -> Option<(Arc<ChunkBuf>, u32, u64)> {
         let Reverse((_, chunk_offset, at, i)) = self.heap.pop()?;
         // heap entries point at live slots
         let slot = self.slots.get_mut(i)?.as_mut()?;
@@ -290,7 +290,10 @@ pub struct MessageStream {
     catalog: Catalog,
     file_len: u64,
     mode: Mode,
-    last_time: Option<(String, Nanos)>,
+    /// The channel and time of the last message handed out when reading in file order (its
+    /// topic names it in errors; the channel is kept rather than its topic so that no message
+    /// allocates).
+    last_time: Option<(Arc<ChannelInfo>, Nanos)>,
     done: bool,
 }
 
@@ -426,7 +429,7 @@ impl Linear {
         &mut self,
         catalog: &mut Catalog,
         file_len: u64,
-        last_time: &Option<(String, Nanos)>,
+        last_time: &Option<(Arc<ChannelInfo>, Nanos)>,
     ) -> Result<Option<Message>, LogErrorKind> {
         let head_len = RECORD_HEAD_LEN as u64;
         loop {
@@ -451,7 +454,7 @@ impl Linear {
                     offset: record_pos,
                     needed: len.saturating_add(head_len),
                     file_len,
-                    last: last_time.clone(),
+                    last: last_time.as_ref().map(|(ch, t)| (ch.topic.clone(), *t)),
                 });
             }
             self.pos += head_len + len;
@@ -492,7 +495,7 @@ impl Linear {
             op::MESSAGE => {
                 let h = parse_message_header(body).map_err(bad("message", record_pos))?;
                 if catalog.wants(h.channel) {
-                    let buf = Arc::new(record);
+                    let buf = Arc::new(ChunkBuf(record));
                     return catalog.message_at(&buf, 0, record_pos).map(Some);
                 }
             }
@@ -548,7 +551,9 @@ impl Iterator for MessageStream {
                     .on_topic(m.topic())
                     .at(m.log_time)));
                 }
-                self.last_time = Some((m.channel.topic.clone(), m.log_time));
+                if matches!(self.mode, Mode::Linear(_)) {
+                    self.last_time = Some((Arc::clone(&m.channel), m.log_time));
+                }
                 Some(Ok(m))
             }
             Ok(None) => {
