@@ -117,6 +117,9 @@ pub struct LocalParams {
     pub majority_filter: bool,
     /// Smallest blob that is a person candidate (pixels).
     pub min_area_px: u64,
+    /// Blobs sharing a column with at most this share of their union's height between them
+    /// are fragments of one person ([`fragments`]); ≤ −1 turns grouping off.
+    pub group_gap: f64,
     /// A blob continues a track when its centroid is within this many σ of the track.
     pub gate_sigma: f64,
     /// Frames a blob track may go unseen before it ends.
@@ -158,6 +161,7 @@ impl Default for LocalParams {
             connectivity: Connectivity::Eight,
             majority_filter: true,
             min_area_px: 120,
+            group_gap: 0.3,
             gate_sigma: 3.0,
             max_missed: 5,
             still_frames: 15,
@@ -207,6 +211,9 @@ impl LocalParams {
             if !(0.0..=1.0).contains(&v) {
                 return bad(name, v, "must be in [0, 1]");
             }
+        }
+        if !self.group_gap.is_finite() {
+            return bad("group_gap", self.group_gap, "must be finite");
         }
         if self.still_frames == 0 {
             return bad("still_frames", 0.0, "must be at least 1");
@@ -463,10 +470,11 @@ impl LocalTracker {
             FOREGROUND,
             &mut self.labels,
         )?;
-        self.blobs = all
+        let kept = all
             .into_iter()
             .filter(|b| b.area() >= self.params.min_area_px)
             .collect();
+        self.blobs = fragments::group(kept, &mut self.labels, self.params.group_gap);
         Ok(())
     }
 
@@ -741,5 +749,6 @@ impl LocalTracker {
 }
 
 mod careful;
+mod fragments;
 #[cfg(test)]
 mod tests;
