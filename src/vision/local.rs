@@ -53,6 +53,12 @@
 //!    Bhattacharyya coefficient wins (the previous region on ties). How many, and how far,
 //!    the paper does not say; these are ours. Off by default (`random_starts = 0`): on the
 //!    quick `home_tour` log they kept colour tracks alive on background (see the README).
+//!    A colour region whose size (√ area of its ellipse) falls below `min_region_scale` of the
+//!    body it was handed over with has collapsed onto a small patch of similar colour (on
+//!    `home_tour` a 4 px wide strip at the image border through a drive): the track ends. The
+//!    EM-like region settles *inside* a uniformly coloured body (0.4–0.6 of the blob's size,
+//!    above), so the default 0.25 (a 4× shrink) leaves room for that and for a person
+//!    walking off to twice the distance.
 //! 5. A blob track missed more than `max_missed` frames in a row ends.
 //!
 //! Each [`Observation`] names its track, the mode, the ellipse and box, and (in blob mode)
@@ -152,6 +158,9 @@ pub struct LocalParams {
     pub random_starts: u32,
     /// They are shifted uniformly within ± this many σ of the region, per axis.
     pub random_start_sigma: f64,
+    /// A colour-tracked region whose size (√ of its ellipse's area) falls below this share of
+    /// the body it was handed over with has collapsed: the track ends (0 never ends one).
+    pub min_region_scale: f64,
 }
 
 impl Default for LocalParams {
@@ -183,6 +192,7 @@ impl Default for LocalParams {
             protect_frames: 220,
             random_starts: 0,
             random_start_sigma: 1.0,
+            min_region_scale: 0.25,
         }
     }
 }
@@ -207,6 +217,7 @@ impl LocalParams {
         for (name, v) in [
             ("min_similarity", self.min_similarity),
             ("reacquire_overlap", self.reacquire_overlap),
+            ("min_region_scale", self.min_region_scale),
         ] {
             if !(0.0..=1.0).contains(&v) {
                 return bad(name, v, "must be in [0, 1]");
@@ -501,7 +512,11 @@ impl LocalTracker {
             }
             let c = r.region.center;
             let inside = c.x >= 0.0 && c.y >= 0.0 && c.x < w && c.y < h;
-            if r.lost || !inside || r.similarity < self.params.min_similarity {
+            if r.lost
+                || !inside
+                || r.similarity < self.params.min_similarity
+                || careful::collapsed(&r.region, t.body.as_ref(), p.min_region_scale)
+            {
                 t.ended = true;
                 continue;
             }

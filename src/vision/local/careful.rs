@@ -8,6 +8,13 @@ use crate::vision::ellipse::Ellipse;
 use crate::vision::gmm::BACKGROUND;
 use crate::vision::view::ImageView;
 
+/// Whether a colour-tracked `region` has collapsed: its size (√ of its ellipse's area) below
+/// `min_scale` of the `body` it was handed over with (never without a body or with
+/// `min_scale` 0).
+pub(super) fn collapsed(region: &Ellipse, body: Option<&Ellipse>, min_scale: f64) -> bool {
+    body.is_some_and(|b| region.area(1.0) < min_scale * min_scale * b.area(1.0))
+}
+
 /// Seed of the colour tracker's random initialisations (hashed with track, frame and draw).
 const RANDOM_START_SEED: u64 = 0x5a6a_de1c_0003;
 

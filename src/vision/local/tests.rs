@@ -312,3 +312,21 @@ fn random_starts_are_deterministic_shifts_within_the_stated_range() {
         careful::random_start(&region, 8, 0, 0, &p)
     );
 }
+
+/// A colour region ends when its size (√ area) falls below `min_region_scale` of its
+/// hand-over body's: exactly at the scale, not below it; never without a body or at 0.
+#[test]
+fn a_collapsed_colour_region_is_recognised_at_the_stated_scale() {
+    let body = Ellipse::from_parts(50.0, 40.0, 9.0, 0.0, 64.0);
+    let at = |s: f64| Ellipse::new(Point2::new(10.0, 5.0), body.cov * (s * s));
+    assert!(!careful::collapsed(&at(0.25), Some(&body), 0.25));
+    assert!(careful::collapsed(&at(0.249), Some(&body), 0.25));
+    assert!(!careful::collapsed(&at(1.0), Some(&body), 0.25));
+    // a thin strip: 1/8 of the width at full height is 1/√8 ≈ 0.354 of the size (kept);
+    // 1/20 of the width is 0.224 (collapsed)
+    let strip = |f: f64| Ellipse::from_parts(2.0, 40.0, 9.0 * f * f, 0.0, 64.0);
+    assert!(!careful::collapsed(&strip(1.0 / 8.0), Some(&body), 0.25));
+    assert!(careful::collapsed(&strip(1.0 / 20.0), Some(&body), 0.25));
+    assert!(!careful::collapsed(&at(0.01), None, 0.25));
+    assert!(!careful::collapsed(&at(0.01), Some(&body), 0.0));
+}
