@@ -138,6 +138,9 @@ pub struct LocalParams {
     pub min_travel_px: f64,
     /// Frames after a (re)start of the background model during which no blobs are taken.
     pub warmup_frames: u32,
+    /// After the warm-up the model learns at the steady α = 1/T (a still person joins the
+    /// background after the paper's 220 frames) instead of OpenCV's bootstrap 1/(2n).
+    pub steady_after_warmup: bool,
     /// Colour space of the colour tracker.
     pub color: ColorSpace,
     /// The colour tracker.
@@ -177,6 +180,7 @@ impl Default for LocalParams {
             still_speed_px: 0.5,
             min_travel_px: 10.0,
             warmup_frames: 30,
+            steady_after_warmup: true,
             color: ColorSpace::Hs,
             // β consistent with the 2-D cut-off: the paper's 1.1 shrinks the region every
             // frame (see `colortrack::consistent_beta`), which a long hand-over cannot afford

@@ -37,6 +37,14 @@ pub(super) fn random_start(
 }
 
 impl LocalTracker {
+    /// The background model's learning rate for this frame: OpenCV's bootstrap
+    /// α = 1/min(2n, T) during the warm-up after a (re)start, then the steady α = 1/T (with
+    /// `steady_after_warmup`; else the bootstrap throughout, as OpenCV).
+    pub(super) fn learning_rate(&self) -> Option<f32> {
+        (self.params.steady_after_warmup && self.since_reset >= self.params.warmup_frames)
+            .then(|| 1.0 / self.params.gmm.history as f32)
+    }
+
     /// Update the background model and its mask, not learning the protected tracks' body
     /// boxes (see the module doc); pixels without a model are not foreground.
     pub(super) fn learn_selectively(&mut self, frame: ImageView<'_>) -> Result<(), LocalError> {
@@ -63,12 +71,13 @@ impl LocalTracker {
             }
         }
         let before = self.unmodelled.then(|| self.gmm.components_per_pixel());
+        let rate = self.learning_rate();
         if protecting {
             self.stats.protected_frames += 1;
             self.gmm
-                .apply_selective(frame, None, &self.learn, &mut self.mask)?;
+                .apply_selective(frame, rate, &self.learn, &mut self.mask)?;
         } else {
-            self.gmm.apply(frame, None, &mut self.mask)?;
+            self.gmm.apply(frame, rate, &mut self.mask)?;
         }
         if let Some(before) = before {
             for (i, m) in self.mask.iter_mut().enumerate() {

@@ -330,3 +330,50 @@ fn a_collapsed_colour_region_is_recognised_at_the_stated_scale() {
     assert!(!careful::collapsed(&at(0.01), None, 0.25));
     assert!(!careful::collapsed(&at(0.01), Some(&body), 0.0));
 }
+
+/// Frames until the pixel at the person's (upper-body) centre turns background after it
+/// appears, standing still, on frame `appear` (counted from 0), or `None` within `limit`.
+fn absorbed_after(p: LocalParams, appear: u64, limit: u64) -> Option<u64> {
+    let mut t = LocalTracker::new(p).expect("tracker");
+    let at = (40, 30);
+    let probe = (at.1 as usize + 3) * W + at.0 as usize + 4;
+    for k in 0..appear + limit {
+        let person = (k >= appear).then_some(at);
+        step(&mut t, &frame(k, 0, person), false);
+        if k >= appear && t.mask()[probe] != FOREGROUND {
+            return Some(k - appear);
+        }
+    }
+    None
+}
+
+/// After the warm-up the model learns at α = 1/T: a still person joins the background after
+/// ln(1 − c_f) / ln(1 − α) = ln 0.9 / ln(1 − 1/200) = 21.0 frames (Zivkovic 2004), however
+/// young the model; OpenCV's bootstrap α = 1/(2n) absorbs them after ≈ 0.21 n frames.
+#[test]
+fn after_the_warm_up_a_still_person_joins_the_background_at_the_steady_rate() {
+    let p = params();
+    let t = LocalTracker::new(p).expect("tracker");
+    assert_eq!(t.learning_rate(), None);
+    let expected = (0.9f64.ln() / (1.0 - 1.0 / 200.0f64).ln()).ceil() as u64;
+    assert_eq!(expected, 22);
+    // appearing on frame 20 (model 20 frames old, past the 8-frame warm-up)
+    let steady = absorbed_after(p, 20, 100).expect("absorbed");
+    assert!(
+        (expected - 1..=expected + 1).contains(&steady),
+        "{steady} frames, expected {expected} ± 1"
+    );
+    let bootstrap = absorbed_after(
+        LocalParams {
+            steady_after_warmup: false,
+            ..p
+        },
+        20,
+        100,
+    )
+    .expect("absorbed");
+    assert!(
+        bootstrap < 10,
+        "bootstrap absorbed after {bootstrap} frames"
+    );
+}
