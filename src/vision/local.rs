@@ -126,6 +126,10 @@ pub struct LocalParams {
     /// Blobs sharing a column with at most this share of their union's height between them
     /// are fragments of one person ([`fragments`]); ≤ −1 turns grouping off.
     pub group_gap: f64,
+    /// Only upright blobs (vertical variance of the moments ≥ horizontal) are person
+    /// candidates, after grouping (Zajdel et al. §III-A: "just first two moments of the blobs
+    /// to detect the interesting ones").
+    pub upright_only: bool,
     /// A blob continues a track when its centroid is within this many σ of the track.
     pub gate_sigma: f64,
     /// Frames a blob track may go unseen before it ends.
@@ -174,6 +178,7 @@ impl Default for LocalParams {
             majority_filter: true,
             min_area_px: 120,
             group_gap: 0.3,
+            upright_only: true,
             gate_sigma: 3.0,
             max_missed: 5,
             still_frames: 15,
@@ -490,6 +495,9 @@ impl LocalTracker {
             .filter(|b| b.area() >= self.params.min_area_px)
             .collect();
         self.blobs = fragments::group(kept, &mut self.labels, self.params.group_gap);
+        if self.params.upright_only {
+            self.blobs.retain(fragments::upright);
+        }
         Ok(())
     }
 

@@ -32,6 +32,14 @@ fn same_person(a: &Blob, b: &Blob, group_gap: f64) -> bool {
     gap as f64 <= group_gap * height as f64
 }
 
+/// Whether a blob is upright: the vertical variance of its pixels at least the horizontal
+/// (a standing person; a passing car or a lying shadow is wider than tall).
+pub(super) fn upright(b: &Blob) -> bool {
+    b.moments
+        .covariance()
+        .is_some_and(|c| c[(1, 1)] >= c[(0, 0)])
+}
+
 fn merge(a: &Blob, b: &Blob) -> Blob {
     Blob {
         label: a.label.min(b.label),
@@ -136,6 +144,18 @@ mod tests {
         for (l, m) in labels.iter().zip(&mask) {
             assert_eq!(*l, if *m == 255 { 1 } else { 0 });
         }
+    }
+
+    #[test]
+    fn upright_blobs_are_taller_than_wide_by_their_moments() {
+        // a 10×30 person, a 30×10 car, a 20×20 square (equal variances: upright)
+        let (b, _, _) = labelled(
+            100,
+            100,
+            &[[5, 5, 14, 34], [40, 5, 69, 14], [40, 50, 59, 69]],
+        );
+        let up: Vec<bool> = b.iter().map(upright).collect();
+        assert_eq!(up, vec![true, false, true]);
     }
 
     #[test]
