@@ -7,7 +7,11 @@
 //! 1. **Detection** (camera still): the adaptive GMM ([`super::gmm`]) gives a mask; shadow
 //!    pixels are dropped, a 3×3 majority filter cleans it, and its connected components
 //!    ([`super::blobs`]) of at least `min_area_px` pixels are the blobs, each summarised by
-//!    its first two moments (an [`Ellipse`]).
+//!    its first two moments (an [`Ellipse`]). Blobs one above the other in one column are
+//!    grouped into one person (`group_gap`, `local::fragments`: a shirt lost against the
+//!    background splits a person in two), and with `upright_only` only blobs whose moments
+//!    are taller than wide are kept. After the `warmup_frames` of a (re)start the model
+//!    learns at the steady α = 1/T (`steady_after_warmup`; see `careful::learning_rate`).
 //! 2. **Colour tracking**: tracks handed over to the colour tracker move with the EM-like
 //!    algorithm ([`super::colortrack::em_like`]); a track whose similarity ρ drops below
 //!    `min_similarity`, or that is lost or leaves the image, ends.
@@ -124,7 +128,7 @@ pub struct LocalParams {
     /// Smallest blob that is a person candidate (pixels).
     pub min_area_px: u64,
     /// Blobs sharing a column with at most this share of their union's height between them
-    /// are fragments of one person ([`fragments`]); ≤ −1 turns grouping off.
+    /// are fragments of one person (`local::fragments`); ≤ −1 turns grouping off.
     pub group_gap: f64,
     /// Only upright blobs (vertical variance of the moments ≥ horizontal) are person
     /// candidates, after grouping (Zajdel et al. §III-A: "just first two moments of the blobs
