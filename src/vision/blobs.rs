@@ -14,7 +14,7 @@
 //! would add a dependency tree (and its build time) and a second pass for the moments.
 //!
 //! Not here: morphology beyond the 3×3 majority filter, contour tracing, holes, blob merging
-//! (the local tracker merges fragments near a track).
+//! (the local tracker groups the fragments of one person and merges fragments near a track).
 
 use super::ellipse::Ellipse;
 use nalgebra::{Matrix2, Point2};

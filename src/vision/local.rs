@@ -7,7 +7,11 @@
 //! 1. **Detection** (camera still): the adaptive GMM ([`super::gmm`]) gives a mask; shadow
 //!    pixels are dropped, a 3×3 majority filter cleans it, and its connected components
 //!    ([`super::blobs`]) of at least `min_area_px` pixels are the blobs, each summarised by
-//!    its first two moments (an [`Ellipse`]).
+//!    its first two moments (an [`Ellipse`]). Blobs one above the other in one column are
+//!    grouped into one person (`group_gap`, `local::fragments`: a shirt lost against the
+//!    background splits a person in two), and with `upright_only` only blobs whose moments
+//!    are taller than wide are kept. After the `warmup_frames` of a (re)start the model
+//!    learns at the steady α = 1/T (`steady_after_warmup`; see `careful::learning_rate`).
 //! 2. **Colour tracking**: tracks handed over to the colour tracker move with the EM-like
 //!    algorithm ([`super::colortrack::em_like`]); a track whose similarity ρ drops below
 //!    `min_similarity`, or that is lost or leaves the image, ends.
@@ -53,6 +57,12 @@
 //!    Bhattacharyya coefficient wins (the previous region on ties). How many, and how far,
 //!    the paper does not say; these are ours. Off by default (`random_starts = 0`): on the
 //!    quick `home_tour` log they kept colour tracks alive on background (see the README).
+//!    A colour region whose size (√ area of its ellipse) falls below `min_region_scale` of the
+//!    body it was handed over with has collapsed onto a small patch of similar colour (on
+//!    `home_tour` a 4 px wide strip at the image border through a drive): the track ends. The
+//!    EM-like region settles *inside* a uniformly coloured body (0.4–0.6 of the blob's size,
+//!    above), so the default 0.25 (a 4× shrink) leaves room for that and for a person
+//!    walking off to twice the distance.
 //! 5. A blob track missed more than `max_missed` frames in a row ends.
 //!
 //! Each [`Observation`] names its track, the mode, the ellipse and box, and (in blob mode)
@@ -117,6 +127,13 @@ pub struct LocalParams {
     pub majority_filter: bool,
     /// Smallest blob that is a person candidate (pixels).
     pub min_area_px: u64,
+    /// Blobs sharing a column with at most this share of their union's height between them
+    /// are fragments of one person (`local::fragments`); ≤ −1 turns grouping off.
+    pub group_gap: f64,
+    /// Only upright blobs (vertical variance of the moments ≥ horizontal) are person
+    /// candidates, after grouping (Zajdel et al. §III-A: "just first two moments of the blobs
+    /// to detect the interesting ones").
+    pub upright_only: bool,
     /// A blob continues a track when its centroid is within this many σ of the track.
     pub gate_sigma: f64,
     /// Frames a blob track may go unseen before it ends.
@@ -129,6 +146,9 @@ pub struct LocalParams {
     pub min_travel_px: f64,
     /// Frames after a (re)start of the background model during which no blobs are taken.
     pub warmup_frames: u32,
+    /// After the warm-up the model learns at the steady α = 1/T (a still person joins the
+    /// background after the paper's 220 frames) instead of OpenCV's bootstrap 1/(2n).
+    pub steady_after_warmup: bool,
     /// Colour space of the colour tracker.
     pub color: ColorSpace,
     /// The colour tracker.
@@ -149,6 +169,9 @@ pub struct LocalParams {
     pub random_starts: u32,
     /// They are shifted uniformly within ± this many σ of the region, per axis.
     pub random_start_sigma: f64,
+    /// A colour-tracked region whose size (√ of its ellipse's area) falls below this share of
+    /// the body it was handed over with has collapsed: the track ends (0 never ends one).
+    pub min_region_scale: f64,
 }
 
 impl Default for LocalParams {
@@ -158,12 +181,15 @@ impl Default for LocalParams {
             connectivity: Connectivity::Eight,
             majority_filter: true,
             min_area_px: 120,
+            group_gap: 0.3,
+            upright_only: true,
             gate_sigma: 3.0,
             max_missed: 5,
             still_frames: 15,
             still_speed_px: 0.5,
             min_travel_px: 10.0,
             warmup_frames: 30,
+            steady_after_warmup: true,
             color: ColorSpace::Hs,
             // β consistent with the 2-D cut-off: the paper's 1.1 shrinks the region every
             // frame (see `colortrack::consistent_beta`), which a long hand-over cannot afford
@@ -179,6 +205,7 @@ impl Default for LocalParams {
             protect_frames: 220,
             random_starts: 0,
             random_start_sigma: 1.0,
+            min_region_scale: 0.25,
         }
     }
 }
@@ -203,10 +230,14 @@ impl LocalParams {
         for (name, v) in [
             ("min_similarity", self.min_similarity),
             ("reacquire_overlap", self.reacquire_overlap),
+            ("min_region_scale", self.min_region_scale),
         ] {
             if !(0.0..=1.0).contains(&v) {
                 return bad(name, v, "must be in [0, 1]");
             }
+        }
+        if !self.group_gap.is_finite() {
+            return bad("group_gap", self.group_gap, "must be finite");
         }
         if self.still_frames == 0 {
             return bad("still_frames", 0.0, "must be at least 1");
@@ -463,10 +494,14 @@ impl LocalTracker {
             FOREGROUND,
             &mut self.labels,
         )?;
-        self.blobs = all
+        let kept = all
             .into_iter()
             .filter(|b| b.area() >= self.params.min_area_px)
             .collect();
+        self.blobs = fragments::group(kept, &mut self.labels, self.params.group_gap);
+        if self.params.upright_only {
+            self.blobs.retain(fragments::upright);
+        }
         Ok(())
     }
 
@@ -493,7 +528,11 @@ impl LocalTracker {
             }
             let c = r.region.center;
             let inside = c.x >= 0.0 && c.y >= 0.0 && c.x < w && c.y < h;
-            if r.lost || !inside || r.similarity < self.params.min_similarity {
+            if r.lost
+                || !inside
+                || r.similarity < self.params.min_similarity
+                || careful::collapsed(&r.region, t.body.as_ref(), p.min_region_scale)
+            {
                 t.ended = true;
                 continue;
             }
@@ -741,5 +780,6 @@ impl LocalTracker {
 }
 
 mod careful;
+mod fragments;
 #[cfg(test)]
 mod tests;

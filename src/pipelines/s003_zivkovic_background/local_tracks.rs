@@ -120,8 +120,9 @@ impl LocalRun {
                         id: person_key(person.id, person.height),
                         x0: b[0],
                         y0: b[1],
-                        x1: b[2] + 1.0,
-                        y1: b[3] + 1.0,
+                        // the ground truth's box is already right and bottom exclusive
+                        x1: b[2],
+                        y1: b[3],
                         visibility: v.visibility,
                     });
                 }

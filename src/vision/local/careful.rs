@@ -8,6 +8,13 @@ use crate::vision::ellipse::Ellipse;
 use crate::vision::gmm::BACKGROUND;
 use crate::vision::view::ImageView;
 
+/// Whether a colour-tracked `region` has collapsed: its size (√ of its ellipse's area) below
+/// `min_scale` of the `body` it was handed over with (never without a body or with
+/// `min_scale` 0).
+pub(super) fn collapsed(region: &Ellipse, body: Option<&Ellipse>, min_scale: f64) -> bool {
+    body.is_some_and(|b| region.area(1.0) < min_scale * min_scale * b.area(1.0))
+}
+
 /// Seed of the colour tracker's random initialisations (hashed with track, frame and draw).
 const RANDOM_START_SEED: u64 = 0x5a6a_de1c_0003;
 
@@ -30,6 +37,14 @@ pub(super) fn random_start(
 }
 
 impl LocalTracker {
+    /// The background model's learning rate for this frame: OpenCV's bootstrap
+    /// α = 1/min(2n, T) during the warm-up after a (re)start, then the steady α = 1/T (with
+    /// `steady_after_warmup`; else the bootstrap throughout, as OpenCV).
+    pub(super) fn learning_rate(&self) -> Option<f32> {
+        (self.params.steady_after_warmup && self.since_reset >= self.params.warmup_frames)
+            .then(|| 1.0 / self.params.gmm.history as f32)
+    }
+
     /// Update the background model and its mask, not learning the protected tracks' body
     /// boxes (see the module doc); pixels without a model are not foreground.
     pub(super) fn learn_selectively(&mut self, frame: ImageView<'_>) -> Result<(), LocalError> {
@@ -56,12 +71,13 @@ impl LocalTracker {
             }
         }
         let before = self.unmodelled.then(|| self.gmm.components_per_pixel());
+        let rate = self.learning_rate();
         if protecting {
             self.stats.protected_frames += 1;
             self.gmm
-                .apply_selective(frame, None, &self.learn, &mut self.mask)?;
+                .apply_selective(frame, rate, &self.learn, &mut self.mask)?;
         } else {
-            self.gmm.apply(frame, None, &mut self.mask)?;
+            self.gmm.apply(frame, rate, &mut self.mask)?;
         }
         if let Some(before) = before {
             for (i, m) in self.mask.iter_mut().enumerate() {

@@ -312,3 +312,68 @@ fn random_starts_are_deterministic_shifts_within_the_stated_range() {
         careful::random_start(&region, 8, 0, 0, &p)
     );
 }
+
+/// A colour region ends when its size (√ area) falls below `min_region_scale` of its
+/// hand-over body's: exactly at the scale, not below it; never without a body or at 0.
+#[test]
+fn a_collapsed_colour_region_is_recognised_at_the_stated_scale() {
+    let body = Ellipse::from_parts(50.0, 40.0, 9.0, 0.0, 64.0);
+    let at = |s: f64| Ellipse::new(Point2::new(10.0, 5.0), body.cov * (s * s));
+    assert!(!careful::collapsed(&at(0.25), Some(&body), 0.25));
+    assert!(careful::collapsed(&at(0.249), Some(&body), 0.25));
+    assert!(!careful::collapsed(&at(1.0), Some(&body), 0.25));
+    // a thin strip: 1/8 of the width at full height is 1/√8 ≈ 0.354 of the size (kept);
+    // 1/20 of the width is 0.224 (collapsed)
+    let strip = |f: f64| Ellipse::from_parts(2.0, 40.0, 9.0 * f * f, 0.0, 64.0);
+    assert!(!careful::collapsed(&strip(1.0 / 8.0), Some(&body), 0.25));
+    assert!(careful::collapsed(&strip(1.0 / 20.0), Some(&body), 0.25));
+    assert!(!careful::collapsed(&at(0.01), None, 0.25));
+    assert!(!careful::collapsed(&at(0.01), Some(&body), 0.0));
+}
+
+/// Frames until the pixel at the person's (upper-body) centre turns background after it
+/// appears, standing still, on frame `appear` (counted from 0), or `None` within `limit`.
+fn absorbed_after(p: LocalParams, appear: u64, limit: u64) -> Option<u64> {
+    let mut t = LocalTracker::new(p).expect("tracker");
+    let at = (40, 30);
+    let probe = (at.1 as usize + 3) * W + at.0 as usize + 4;
+    for k in 0..appear + limit {
+        let person = (k >= appear).then_some(at);
+        step(&mut t, &frame(k, 0, person), false);
+        if k >= appear && t.mask()[probe] != FOREGROUND {
+            return Some(k - appear);
+        }
+    }
+    None
+}
+
+/// After the warm-up the model learns at α = 1/T: a still person joins the background after
+/// ln(1 − c_f) / ln(1 − α) = ln 0.9 / ln(1 − 1/200) = 21.0 frames (Zivkovic 2004), however
+/// young the model; OpenCV's bootstrap α = 1/(2n) absorbs them after ≈ 0.21 n frames.
+#[test]
+fn after_the_warm_up_a_still_person_joins_the_background_at_the_steady_rate() {
+    let p = params();
+    let t = LocalTracker::new(p).expect("tracker");
+    assert_eq!(t.learning_rate(), None);
+    let expected = (0.9f64.ln() / (1.0 - 1.0 / 200.0f64).ln()).ceil() as u64;
+    assert_eq!(expected, 22);
+    // appearing on frame 20 (model 20 frames old, past the 8-frame warm-up)
+    let steady = absorbed_after(p, 20, 100).expect("absorbed");
+    assert!(
+        (expected - 1..=expected + 1).contains(&steady),
+        "{steady} frames, expected {expected} ± 1"
+    );
+    let bootstrap = absorbed_after(
+        LocalParams {
+            steady_after_warmup: false,
+            ..p
+        },
+        20,
+        100,
+    )
+    .expect("absorbed");
+    assert!(
+        bootstrap < 10,
+        "bootstrap absorbed after {bootstrap} frames"
+    );
+}
