@@ -48,7 +48,8 @@ pub struct FollowerState {
 pub struct CameraView {
     /// Camera name as in its topics (`cam_0`, `omni_camera`).
     pub camera: String,
-    /// Bounding box `[x0, y0, x1, y1]` of the visible pixels, if any are visible.
+    /// Bounding box `[x0, y0, x1, y1]` of the visible pixels, if any are visible; right and
+    /// bottom exclusive (the last visible column is `x1 - 1`).
     pub bbox: Option<[f64; 4]>,
     /// Projection of the top of the head, if it is inside the image.
     pub head_px: Option<[f64; 2]>,

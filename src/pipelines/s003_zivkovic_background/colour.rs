@@ -78,8 +78,9 @@ pub(super) fn mask_ellipse(
 ) -> Option<Ellipse> {
     let x0 = bbox[0].max(0.0) as usize;
     let y0 = bbox[1].max(0.0) as usize;
-    let x1 = (bbox[2].max(0.0) as usize).min(width.checked_sub(1)?);
-    let y1 = (bbox[3].max(0.0) as usize).min(height.checked_sub(1)?);
+    // the logged box is right and bottom exclusive: its last pixel is x1 - 1
+    let x1 = ((bbox[2] - 1.0).max(0.0) as usize).min(width.checked_sub(1)?);
+    let y1 = ((bbox[3] - 1.0).max(0.0) as usize).min(height.checked_sub(1)?);
     if x1 < x0 || y1 < y0 {
         return None;
     }

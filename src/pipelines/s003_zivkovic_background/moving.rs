@@ -86,7 +86,7 @@ impl MovingRun {
             .flat_map(|fr| &fr.people)
             .flat_map(|person| &person.cameras)
             .filter(|v| v.camera == self.camera && v.visibility >= self.min_visibility)
-            .filter_map(|v| v.bbox.map(|b| [b[0], b[1], b[2] + 1.0, b[3] + 1.0]))
+            .filter_map(|v| v.bbox) // right and bottom exclusive, as logged
             .collect();
         self.count(&out, &truth);
     }

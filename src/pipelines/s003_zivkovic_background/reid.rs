@@ -179,8 +179,8 @@ impl ReidRun {
                 if let Some(b) = v.bbox
                     && v.visibility >= self.min_visibility
                 {
-                    // ground-truth boxes are inclusive: right and bottom + 1
-                    truth_boxes.push((i64::from(person.id), [b[0], b[1], b[2] + 1.0, b[3] + 1.0]));
+                    // the logged box is already right and bottom exclusive
+                    truth_boxes.push((i64::from(person.id), b));
                 }
             }
         }

@@ -379,8 +379,9 @@ fn count_person(
     }
     let x0 = bbox[0].max(0.0) as usize;
     let y0 = bbox[1].max(0.0) as usize;
-    let x1 = (bbox[2].max(0.0) as usize).min(width - 1);
-    let y1 = (bbox[3].max(0.0) as usize).min(height - 1);
+    // the logged box is right and bottom exclusive: its last pixel is x1 - 1
+    let x1 = ((bbox[2] - 1.0).max(0.0) as usize).min(width - 1);
+    let y1 = ((bbox[3] - 1.0).max(0.0) as usize).min(height - 1);
     for y in y0..=y1 {
         for x in x0..=x1 {
             let i = y * width + x;
