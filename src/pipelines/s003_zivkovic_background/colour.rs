@@ -300,7 +300,7 @@ mod tests {
 
     #[test]
     fn the_truth_ellipse_is_the_moments_of_the_largest_part_in_the_box() {
-        // a 5x9 block (x 4..=8, y 2..=10) and a stray pixel inside the box
+        // a 5x9 block (x 4..=8, y 2..=10) and a stray pixel inside the (exclusive) box
         let mut mask = rect_mask(20, 16, 4, 2, 8, 10);
         mask[14 * 20 + 2] = 255;
         let e = mask_ellipse(&mask, 20, 16, [0.0, 0.0, 12.0, 15.0]).expect("ellipse");
@@ -336,7 +336,8 @@ mod tests {
         });
         let truth = PeopleFrame {
             stamp_ns: 0,
-            people: vec![person(1, 1.7, [8.0, 5.0, 12.0, 13.0], 1.0)],
+            // the logged box is right / bottom exclusive
+            people: vec![person(1, 1.7, [8.0, 5.0, 13.0, 14.0], 1.0)],
         };
         let mut p = Params::default();
         p.colour.spaces = vec![ColorSpace::Rgb];

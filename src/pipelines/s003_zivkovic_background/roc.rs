@@ -452,7 +452,8 @@ mod tests {
         let truth = [0, 255, 255, 0, 0, 255, 255, 0, 255, 0, 0, 0];
         let predicted = [0, 255, 127, 255, 0, 0, 255, 0, 255, 0, 0, 0];
         let mut c = PeopleCounts::default();
-        count_person(&predicted, &truth, 4, [1.0, 0.0, 2.0, 1.0], 127, &mut c);
+        // the logged box is right / bottom exclusive
+        count_person(&predicted, &truth, 4, [1.0, 0.0, 3.0, 2.0], 127, &mut c);
         assert_eq!((c.person_px, c.foreground_px, c.shadow_px), (4, 2, 1));
     }
 }
