@@ -209,3 +209,34 @@ fn ground_truth_agrees_with_the_mask_and_the_laser() {
     }
     assert!(near >= 8, "legs seen where expected in only {near} beams");
 }
+
+#[test]
+fn a_crowd_is_numbered_after_the_scripted_people() {
+    // the tiny scenario's scripted person 1 plus a crowd of two (no crossers): every person of
+    // a ground-truth frame has their own id, the crowd's being 2 and 3 (it used to restart at 1,
+    // so person 1 had two bodies and one union box)
+    let dir = tempfile::tempdir().expect("tempdir");
+    let text = std::fs::read_to_string(scenario()).expect("fixture")
+        + "\n[crowd]\ncount = 2\narea = [1.0, 1.0, 4.0, 3.0]\nstay_s = [5.0, 6.0]\nspeed = [0.8, 1.0]\n";
+    let path = dir.path().join("crowd_scenario.toml");
+    std::fs::write(&path, text).expect("write");
+    let summary = synthesize(
+        &path,
+        &SynthOptions {
+            profile: "quick".into(),
+            out: Some(dir.path().join("out")),
+            progress: None,
+        },
+    )
+    .expect("synthesizes");
+    let log = SessionLog::open(&summary.sessions[0]).expect("opens");
+    let mut seen = std::collections::BTreeSet::new();
+    for m in log.messages_on(&["/ground_truth/people"]).expect("gt") {
+        let frame: PeopleFrame = serde_json::from_slice(&m.expect("ok").data).expect("valid");
+        let ids: Vec<u32> = frame.people.iter().map(|p| p.id).collect();
+        let unique: std::collections::BTreeSet<u32> = ids.iter().copied().collect();
+        assert_eq!(unique.len(), ids.len(), "duplicate ids in one frame: {ids:?}");
+        seen.extend(unique);
+    }
+    assert_eq!(seen.into_iter().collect::<Vec<_>>(), vec![1, 2, 3]);
+}

@@ -22,7 +22,9 @@ pub(super) fn people_and_robot(
     session: u64,
 ) -> Result<(Vec<Actor>, RobotTrack), SynthError> {
     let dur = s.scenario.duration_s;
+    let first_crowd_id = first_crowd_id(s);
     let mut people = actors(
+        first_crowd_id,
         &Scenario {
             crowd: None,
             ..s.clone()
@@ -50,10 +52,10 @@ pub(super) fn people_and_robot(
             .is_some_and(|c| c.cross_between_robot_and.is_some())
         {
             // crossers need the target's track: build with the scripted people present
-            let all = actors(s, world, base, session, Some(&robot_track))?;
+            let all = actors(first_crowd_id, s, world, base, session, Some(&robot_track))?;
             all.into_iter().skip(s.people.len()).collect()
         } else {
-            actors(&crowd_only, world, base, session, Some(&robot_track))?
+            actors(first_crowd_id, &crowd_only, world, base, session, Some(&robot_track))?
         };
         people.append(&mut crowd);
     }
@@ -201,8 +203,16 @@ fn scripted_track(
     }
 }
 
-/// Build every actor of a session (scripted people, then the crowd).
+/// The crowd's ids follow the scripted people's, so every person of a session has their own
+/// id (ground truth and the rendered id buffer are keyed by it).
+fn first_crowd_id(s: &Scenario) -> u32 {
+    s.people.iter().map(|p| p.id).max().unwrap_or(0) + 1
+}
+
+/// Build every actor of a session (scripted people, then the crowd numbered from
+/// `first_crowd_id`).
 fn actors(
+    first_crowd_id: u32,
     s: &Scenario,
     world: &World,
     base: &Path,
@@ -219,8 +229,7 @@ fn actors(
     if let Some(c) = &s.crowd {
         let mut r = rng::stream(s.scenario.seed, "crowd", session);
         let dur = s.scenario.duration_s;
-        let first_id = s.people.iter().map(|p| p.id).max().unwrap_or(0) + 1;
-        for (k, next_id) in (0..c.count).zip(first_id..) {
+        for (k, next_id) in (0..c.count).zip(first_crowd_id..) {
             let height = c.height[0] + r.random::<f64>() * (c.height[1] - c.height[0]);
             let body = Body {
                 id: next_id,
