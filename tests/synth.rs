@@ -235,7 +235,11 @@ fn a_crowd_is_numbered_after_the_scripted_people() {
         let frame: PeopleFrame = serde_json::from_slice(&m.expect("ok").data).expect("valid");
         let ids: Vec<u32> = frame.people.iter().map(|p| p.id).collect();
         let unique: std::collections::BTreeSet<u32> = ids.iter().copied().collect();
-        assert_eq!(unique.len(), ids.len(), "duplicate ids in one frame: {ids:?}");
+        assert_eq!(
+            unique.len(),
+            ids.len(),
+            "duplicate ids in one frame: {ids:?}"
+        );
         seen.extend(unique);
     }
     assert_eq!(seen.into_iter().collect::<Vec<_>>(), vec![1, 2, 3]);

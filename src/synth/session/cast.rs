@@ -55,7 +55,14 @@ pub(super) fn people_and_robot(
             let all = actors(first_crowd_id, s, world, base, session, Some(&robot_track))?;
             all.into_iter().skip(s.people.len()).collect()
         } else {
-            actors(first_crowd_id, &crowd_only, world, base, session, Some(&robot_track))?
+            actors(
+                first_crowd_id,
+                &crowd_only,
+                world,
+                base,
+                session,
+                Some(&robot_track),
+            )?
         };
         people.append(&mut crowd);
     }
