@@ -46,19 +46,26 @@ pub(crate) struct VariantOut {
     pub discarded: usize,
 }
 
+impl VariantOut {
+    /// No frames yet, room for `frames`.
+    fn empty(frames: usize) -> Self {
+        Self {
+            tracks: Vec::with_capacity(frames),
+            combinations: 0,
+            pruned_frames: 0,
+            promoted: 0,
+            discarded: 0,
+        }
+    }
+}
+
 pub(crate) fn run_variant(
     views: &[CalibratedView],
     params: CylinderParams,
     frames: &[Vec<Object2d>],
 ) -> anyhow::Result<VariantOut> {
     let mut tracker = CylinderTracker::new(views.to_vec(), params)?;
-    let mut out = VariantOut {
-        tracks: Vec::with_capacity(frames.len()),
-        combinations: 0,
-        pruned_frames: 0,
-        promoted: 0,
-        discarded: 0,
-    };
+    let mut out = VariantOut::empty(frames.len());
     for objs in frames {
         let (cyl, stats) = tracker.step(objs);
         out.combinations += stats.combinations;
@@ -82,13 +89,7 @@ pub(crate) fn run_per_frame(
         n_dis: 1,
         ..params
     };
-    let mut out = VariantOut {
-        tracks: Vec::with_capacity(frames.len()),
-        combinations: 0,
-        pruned_frames: 0,
-        promoted: 0,
-        discarded: 0,
-    };
+    let mut out = VariantOut::empty(frames.len());
     for objs in frames {
         let mut tracker = CylinderTracker::new(views.to_vec(), params)?;
         let (cyl, stats) = tracker.step(objs);
