@@ -2,8 +2,8 @@
 //! on a large image log; `tools/bench_python_read.py` times Python `mcap-ros2-support` on the
 //! same files and `tools/bench_compare.py` prints the ratios.
 //!
-//! Rows per log: `NAME` (the typed fast paths where a channel has one, the dynamic value tree
-//! elsewhere — what `Decoders::decode` does), `NAME_dynamic` (every message through the value
+//! Rows per log: `NAME` (the typed fast paths where a channel has one, flat decoding of the
+//! other CDR types — what `Decoders::decode` does), `NAME_dynamic` (every message through the value
 //! tree) and `NAME_limit`: the physical limit, the file read, every chunk decompressed
 //! (zstd/lz4) and each message payload copied once, with no ordering, no index and no decoding
 //! (a linear walk over the MCAP records written here, independent of `log::reader`).

@@ -4,7 +4,7 @@ Usage: bench_compare.py CRITERION_DIR PYTHON_JSON [PEOPLETRACK_BINARY]
 
 Rows:
 - read + decode every message (`read_decode/NAME`: typed fast paths where a channel has one,
-  the value tree elsewhere) beside Python mcap-ros2-support, with `NAME_dynamic` (value tree
+  flat decoding of the other CDR types) beside Python mcap-ros2-support, with `NAME_dynamic` (value tree
   only) and the physical limit `NAME_limit` (file read + zstd/lz4 decompression + one copy of
   each payload): "limit %" is limit time / decode time (100 % = decoding is free); "py limit
   s" is the same limit measured in Python (its zstandard/lz4 modules, one copy per payload) and
@@ -38,7 +38,7 @@ def cat_seconds(binary, path, topic, runs=5):
 
 def main(criterion_dir, python_json, binary=None):
     py = json.load(open(python_json))
-    print("read + decode every message (ours: typed fast paths + value tree; peer: mcap-ros2-support)")
+    print("read + decode every message (ours: typed fast paths + flat CDR; peer: mcap-ros2-support)")
     print(
         f"{'log':36} {'messages':>9} {'MB':>7} {'ours s':>9} {'python s':>9} {'ratio':>8} "
         f"{'dynamic s':>10} {'limit s':>9} {'limit %':>8} {'ours MB/s':>10} {'py limit s':>11} {'ceiling':>8}"

@@ -6,7 +6,9 @@
 
 use super::skips::Skips;
 use crate::groundtruth::{PeopleFrame, TargetsFrame};
-use crate::log::{LogError, SessionLog, sync};
+use crate::log::fast::Decoded;
+use crate::log::value::FieldError;
+use crate::log::{Decoders, LogError, SessionLog, Value, sync};
 use crate::time::Nanos;
 
 /// Items sorted by stamp, with nearest-stamp lookups.
@@ -105,7 +107,8 @@ pub fn targets(log: &SessionLog, topic: &str) -> Result<(Stamped<TargetsFrame>, 
 
 /// One person position of a `leg_tracker/msg/Person` message (Leigh et al.'s annotated
 /// benchmark logs: `geometry_msgs/Pose pose` + `uint32 id`, no header; the position is in the
-/// laser frame of the annotated scan). Decoded dynamically from the log's own schema.
+/// laser frame of the annotated scan). Decoded by the log's own schema, flat
+/// ([`crate::log::cdr::flat`]: no tree per message).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PersonPosition {
     /// The message's log time: the annotated scan is the last scan logged before it.
@@ -127,28 +130,21 @@ pub fn person_positions(
     if log.summary().channel(topic).is_none() {
         return Ok((rows, skips));
     }
-    let mut decoders = crate::log::Decoders::new();
+    let mut decoders = Decoders::new();
     for m in log.messages_on(&[topic])? {
         let m = m?;
-        let value = match decoders.value(log, &m) {
-            Ok(v) => v,
+        let read = match decoders.decode(log, &m) {
+            Ok(Decoded::Flat(f)) => person_fields(|path| f.get(path)),
+            Ok(Decoded::Value(v)) => {
+                person_fields(|path| path.split('.').try_fold(&v, |v, name| v.get(name)).cloned())
+            }
+            Ok(_) => Err(FieldError::new("a standard message type, not a Person")),
             Err(e) => {
                 skips.note(topic, e);
                 continue;
             }
         };
-        let read = || -> Result<(i64, f64, f64), crate::log::value::FieldError> {
-            let position = value.get("pose")?.get("position")?;
-            let id = value.get("id")?.as_i128()?;
-            let id = i64::try_from(id)
-                .map_err(|_| crate::log::value::FieldError::new("id out of range"))?;
-            Ok((
-                id,
-                position.get("x")?.as_f64()?,
-                position.get("y")?.as_f64()?,
-            ))
-        };
-        match read() {
+        match read {
             Ok((id, x, y)) if x.is_finite() && y.is_finite() => rows.push(PersonPosition {
                 log_time: m.log_time,
                 id,
@@ -160,6 +156,19 @@ pub fn person_positions(
         }
     }
     Ok((rows, skips))
+}
+
+/// `(id, x, y)` of a Person message whose fields `get` reads by dotted path.
+fn person_fields(
+    get: impl Fn(&str) -> Result<Value, FieldError>,
+) -> Result<(i64, f64, f64), FieldError> {
+    let id = get("id")?.as_i128()?;
+    let id = i64::try_from(id).map_err(|_| FieldError::new("id out of range"))?;
+    Ok((
+        id,
+        get("pose.position.x")?.as_f64()?,
+        get("pose.position.y")?.as_f64()?,
+    ))
 }
 
 /// Count a bad message on `topic`, its text naming the file, topic and log time.

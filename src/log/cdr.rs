@@ -124,6 +124,7 @@ type Result<T> = std::result::Result<T, CdrError>;
 
 mod cursor;
 mod encode;
+pub mod flat;
 mod json;
 
 pub use cursor::Cursor;

@@ -21,6 +21,7 @@ use std::sync::Arc;
 use prost_reflect::MessageDescriptor;
 
 use super::cdr;
+use super::cdr::flat::{Flat, Plan};
 use super::error::{LogError, LogErrorKind};
 use super::fast::{self, Decoded, FastKind, Scratch};
 use super::msgs::RosMessage;
@@ -93,21 +94,41 @@ pub fn carries(ch: &ChannelInfo, type_name: &str) -> bool {
     normalize_type_name(ch.schema_name()).is_some_and(|n| n == type_name)
 }
 
-/// One channel's decoder and, for a standard type with the canonical layout, its fast path.
+/// One channel's decoder and, for a standard type with the canonical layout, its fast path;
+/// for the other CDR types, their flat plan.
 #[derive(Debug)]
 struct Entry {
     decoder: Result<Decoder, String>,
     fast: Option<FastKind>,
+    flat: Option<Plan>,
 }
 
 impl Entry {
     fn new(ch: &ChannelInfo) -> Entry {
         let decoder = Decoder::for_channel(ch).map_err(|e| e.to_string());
-        let fast = match &decoder {
-            Ok(Decoder::Cdr(reg)) => FastKind::for_registry(reg),
-            _ => None,
+        let (fast, flat) = match &decoder {
+            Ok(Decoder::Cdr(reg)) => match FastKind::for_registry(reg) {
+                Some(kind) => (Some(kind), None),
+                None => (None, Plan::compile(reg)),
+            },
+            _ => (None, None),
         };
-        Entry { decoder, fast }
+        Entry {
+            decoder,
+            fast,
+            flat,
+        }
+    }
+
+    /// A message of this channel as a value tree.
+    fn tree(&self, msg: &Message) -> Result<Value, LogErrorKind> {
+        match &self.decoder {
+            Ok(dec) => dec.decode(&msg.data),
+            // the parse error is stored as text so it can be reported for every message
+            Err(reason) => Err(Decoder::for_channel(&msg.channel)
+                .err()
+                .unwrap_or(LogErrorKind::Protobuf(reason.clone()))),
+        }
     }
 }
 
@@ -138,8 +159,9 @@ impl Hasher for ChannelIdHasher {
 #[derive(Debug, Default)]
 pub struct Decoders {
     by_channel: HashMap<u16, Entry, BuildHasherDefault<ChannelIdHasher>>,
-    /// Reused buffers of [`Decoders::decode`].
+    /// Reused buffers of [`Decoders::decode`]: the typed fast paths' and the flat decoder's.
     scratch: Scratch,
+    flat: Flat,
     /// Float texts reused by [`Decoders::write_json`].
     floats: cdr::FloatText,
 }
@@ -156,24 +178,9 @@ impl Decoders {
             .or_insert_with(|| Entry::new(ch))
     }
 
-    fn decoder(&mut self, log: &SessionLog, msg: &Message) -> Result<&Decoder, LogError> {
-        let ch = &msg.channel;
-        let entry = &self.entry(msg).decoder;
-        entry.as_ref().map_err(|reason| {
-            // the parse error is stored as text so it can be reported for every message
-            let kind = Decoder::for_channel(ch)
-                .err()
-                .unwrap_or(LogErrorKind::Protobuf(reason.clone()));
-            LogError::new(log.path(), kind)
-                .on_topic(&ch.topic)
-                .at(msg.log_time)
-        })
-    }
-
     /// Decode a message into a value tree; errors name file, topic and log time.
     pub fn value(&mut self, log: &SessionLog, msg: &Message) -> Result<Value, LogError> {
-        let dec = self.decoder(log, msg)?;
-        dec.decode(&msg.data).map_err(|k| {
+        self.entry(msg).tree(msg).map_err(|k| {
             LogError::new(log.path(), k)
                 .on_topic(msg.topic())
                 .at(msg.log_time)
@@ -211,22 +218,35 @@ impl Decoders {
         })
     }
 
-    /// Decode a message by its channel's typed fast path when it has one, else into a value
-    /// tree. The typed forms borrow buffers reused from message to message (no allocation once
-    /// they have grown) and images borrow their pixels from the payload.
+    /// Decode a message by its channel's typed fast path when it has one, else, for the other
+    /// CDR types, flat by its compiled plan ([`cdr::flat`]), else into a value tree. The typed
+    /// and flat forms borrow buffers reused from message to message (no allocation once they
+    /// have grown); images, strings and packed arrays borrow their bytes from the payload. A
+    /// payload the flat walk refuses is decoded to a tree, so its error names the field.
     pub fn decode<'s, 'm>(
         &'s mut self,
         log: &SessionLog,
         msg: &'m Message,
     ) -> Result<Decoded<'s, 'm>, LogError> {
-        match self.entry(msg).fast {
-            Some(kind) => self.scratch.decode(kind, &msg.data).map_err(|e| {
-                LogError::new(log.path(), LogErrorKind::from(e))
-                    .on_topic(msg.topic())
-                    .at(msg.log_time)
-            }),
-            None => self.value(log, msg).map(Decoded::Value),
+        let err = |k: LogErrorKind| {
+            LogError::new(log.path(), k)
+                .on_topic(msg.topic())
+                .at(msg.log_time)
+        };
+        self.entry(msg);
+        let entry = &self.by_channel[&msg.channel.id];
+        if let Some(kind) = entry.fast {
+            return self
+                .scratch
+                .decode(kind, &msg.data)
+                .map_err(|e| err(LogErrorKind::from(e)));
         }
+        if let Some(plan) = &entry.flat
+            && let Ok(r) = self.flat.decode(plan, &msg.data)
+        {
+            return Ok(Decoded::Flat(r));
+        }
+        entry.tree(msg).map(Decoded::Value).map_err(err)
     }
 
     /// Decode a message as the typed `T`, from its ROS 2 type or a Foxglove equivalent.

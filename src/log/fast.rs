@@ -191,6 +191,8 @@ pub enum Decoded<'s, 'm> {
     CameraInfo(&'s CameraInfo),
     Image(ImageRef<'m>),
     CompressedImage(CompressedImageRef<'m>),
+    /// Any other CDR type, decoded flat ([`super::cdr::flat`]).
+    Flat(super::cdr::flat::FlatRef<'s, 'm>),
     Value(super::value::Value),
 }
 

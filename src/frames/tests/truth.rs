@@ -84,3 +84,59 @@ fn people_sorted_bad_counted_and_nearest_within_tolerance() {
     let (none, _) = truth::people(&log, "/ground_truth/none").expect("absent");
     assert!(none.is_empty());
 }
+
+const PERSON_DEF: &str = "geometry_msgs/Pose pose\nuint32 id\n===\nMSG: geometry_msgs/Pose\n\
+    geometry_msgs/Point position\ngeometry_msgs/Quaternion orientation\n===\n\
+    MSG: geometry_msgs/Point\nfloat64 x\nfloat64 y\nfloat64 z\n===\n\
+    MSG: geometry_msgs/Quaternion\nfloat64 x\nfloat64 y\nfloat64 z\nfloat64 w";
+
+/// A `leg_tracker/msg/Person` as rosbags writes it (little-endian CDR, no header field).
+fn person_cdr(x: f64, y: f64, id: u32) -> Vec<u8> {
+    let mut b = vec![0, 1, 0, 0];
+    for v in [x, y, 0.0, 0.0, 0.0, 0.0, 1.0] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    b.extend_from_slice(&id.to_le_bytes());
+    b
+}
+
+/// The flat-decoded CDR channel and a JSON channel of the same fields (the tree path) give
+/// the same rows; a truncated payload and a NaN position are skipped and counted, the first
+/// with the tree decoder's error naming the field.
+#[test]
+fn person_positions_read_cdr_flat_and_json_alike() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let (mut w, path) = writer(dir.path(), "people");
+    let cdr = w
+        .add_ros2_dynamic("/gt", "leg_tracker/msg/Person", PERSON_DEF)
+        .expect("ch");
+    let json = w.add_json("/gt_json", "Person", "{}").expect("ch");
+    w.write_bytes(cdr, s(10), &person_cdr(1.5, -2.0, 7))
+        .expect("w");
+    w.write_bytes(cdr, s(20), &person_cdr(1.5, -2.0, 7)[..40])
+        .expect("w");
+    w.write_bytes(cdr, s(30), &person_cdr(f64::NAN, 0.0, 8))
+        .expect("w");
+    w.write_bytes(cdr, s(40), &person_cdr(-0.25, 3.0, 9))
+        .expect("w");
+    for (t, x, y, id) in [(10, 1.5, -2.0, 7), (40, -0.25, 3.0, 9)] {
+        let m = serde_json::json!({"pose": {"position": {"x": x, "y": y}}, "id": id});
+        w.write_json(json, s(t), &m).expect("w");
+    }
+    w.finish().expect("finish");
+    let log = open(&path);
+    let (rows, skips) = truth::person_positions(&log, "/gt").expect("reads");
+    let (json_rows, json_skips) = truth::person_positions(&log, "/gt_json").expect("reads");
+    let got: Vec<_> = rows.iter().map(|p| (p.log_time, p.id, p.x, p.y)).collect();
+    assert_eq!(got, [(s(10), 7, 1.5, -2.0), (s(40), 9, -0.25, 3.0)]);
+    assert_eq!(json_rows, rows);
+    assert!(json_skips.is_empty());
+    assert_eq!(skips.count("/gt"), 2);
+    let first = skips.first_error_on("/gt").expect("an error");
+    assert!(
+        first.contains("at log time 0.020000000 s") && first.contains("pose.orientation.y"),
+        "{first}"
+    );
+    let (none, _) = truth::person_positions(&log, "/absent").expect("reads");
+    assert!(none.is_empty());
+}
