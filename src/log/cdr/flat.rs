@@ -360,6 +360,17 @@ impl Walk<'_, '_, '_> {
             }
             Leaf::Msgs(d) => {
                 let w = self.plan.layouts[d].width;
+                // Every slot is a field the tree decoder charges as it reads each element: if
+                // that cannot fit, it fails, so fail before the slots are allocated.
+                let least = n
+                    .checked_mul(w)
+                    .and_then(|s| s.checked_mul(std::mem::size_of::<(Arc<str>, Value)>()));
+                if least.is_none_or(|b| b > self.budget) {
+                    return Err(CdrError::new(CdrErrorKind::TreeTooLarge {
+                        budget: tree_budget(self.cur.payload_len()),
+                        payload: self.cur.payload_len(),
+                    }));
+                }
                 let first = self.out.slots.len();
                 self.out.slots.resize(first + n * w, 0);
                 for i in 0..n {

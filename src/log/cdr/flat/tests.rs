@@ -179,6 +179,30 @@ fn corrupted_payloads_fail_or_decode_exactly_as_trees_do() {
     );
 }
 
+/// 65,536 elements of a type of 60,000 zero-length arrays: the tree decoder runs out of its
+/// structure budget within the first elements; the flat walk must refuse before it allocates
+/// 31 GB of slots.
+#[test]
+fn wide_elements_that_take_no_bytes_are_refused_before_allocating() {
+    let mut text = String::from("t/W[] ws\n===\nMSG: t/W\n");
+    for i in 0..60_000 {
+        text.push_str(&format!("int8[0] f{i}\n"));
+    }
+    let r = reg(&text);
+    let plan = Plan::compile(&r).expect("compiles");
+    let data = [0, 1, 0, 0, 0, 0, 1, 0]; // 65,536 elements
+    let tree = decode(&r, &data).expect_err("too large");
+    assert!(
+        matches!(tree.kind, CdrErrorKind::TreeTooLarge { .. }),
+        "{tree}"
+    );
+    let flat = Flat::default()
+        .decode(&plan, &data)
+        .map(|_| ())
+        .expect_err("too large");
+    assert_eq!(flat.kind, tree.kind);
+}
+
 #[test]
 fn a_message_wider_than_the_limit_is_not_compiled() {
     // 2^17 inline slots: 32 fields of a 64-field type of 64 float64 each
