@@ -122,11 +122,13 @@ impl CdrError {
 
 type Result<T> = std::result::Result<T, CdrError>;
 
+mod budget;
 mod cursor;
 mod encode;
 pub mod flat;
 mod json;
 
+use budget::Budget;
 pub use cursor::Cursor;
 pub use encode::{default_value, encode, literal_value};
 pub use json::{FloatText, write_json};
@@ -151,7 +153,7 @@ pub fn decode(registry: &Registry, data: &[u8]) -> Result<Value> {
     let mut reader = Reader {
         cur: Cursor::new(data)?,
         depth: 0,
-        budget: tree_budget(data.len()),
+        budget: Budget::new(data.len()),
     };
     reader.read_struct(registry, registry.root)
 }
@@ -161,59 +163,61 @@ struct Reader<'a> {
     /// Message types entered and not yet left.
     depth: usize,
     /// Bytes of tree structure still allowed ([`tree_budget`]).
-    budget: usize,
+    budget: Budget,
 }
 
-macro_rules! read_packed {
-    ($self:ident, $n:ident, $t:ty, $variant:ident) => {{
+macro_rules! packed {
+    ($bytes:ident, $big:ident, $t:ty, $variant:ident) => {{
         const N: usize = std::mem::size_of::<$t>();
-        let big = $self.cur.is_big_endian();
-        let v: Vec<$t> = $self
-            .cur
-            .packed($n, N)?
-            .as_chunks::<N>()
-            .0
-            .iter()
-            .map(|&c| {
-                if big {
-                    <$t>::from_be_bytes(c)
-                } else {
-                    <$t>::from_le_bytes(c)
-                }
-            })
-            .collect();
-        Value::$variant(v)
+        Value::$variant(
+            $bytes
+                .as_chunks::<N>()
+                .0
+                .iter()
+                .map(|&c| {
+                    if $big {
+                        <$t>::from_be_bytes(c)
+                    } else {
+                        <$t>::from_le_bytes(c)
+                    }
+                })
+                .collect(),
+        )
     }};
 }
 
+/// The bytes of `n` packed elements of `p` at the cursor (aligned first, except single bytes).
+fn packed_bytes<'a>(cur: &mut Cursor<'a>, p: Prim, n: usize) -> Result<&'a [u8]> {
+    match p {
+        Prim::Bool | Prim::Byte | Prim::Char | Prim::U8 | Prim::I8 => cur.take(n),
+        _ => cur.packed(n, p.size()),
+    }
+}
+
+/// Packed elements of `p` (their bytes, in the payload's byte order) as a packed value.
+fn packed_value(p: Prim, bytes: &[u8], big: bool) -> Value {
+    match p {
+        Prim::Bool => Value::Bools(bytes.iter().map(|b| *b != 0).collect()),
+        Prim::Byte | Prim::Char | Prim::U8 => Value::Bytes(bytes.to_vec()),
+        Prim::I8 => Value::I8s(bytes.iter().map(|b| *b as i8).collect()),
+        Prim::I16 => packed!(bytes, big, i16, I16s),
+        Prim::U16 => packed!(bytes, big, u16, U16s),
+        Prim::I32 => packed!(bytes, big, i32, I32s),
+        Prim::U32 => packed!(bytes, big, u32, U32s),
+        Prim::I64 => packed!(bytes, big, i64, I64s),
+        Prim::U64 => packed!(bytes, big, u64, U64s),
+        Prim::F32 => packed!(bytes, big, f32, F32s),
+        Prim::F64 => packed!(bytes, big, f64, F64s),
+    }
+}
+
 impl<'a> Reader<'a> {
-    /// Check an array or sequence length before anything is allocated for it: its elements
-    /// must fit in the bytes left (`min_elem_size` each), or, when they take no bytes at all,
-    /// be at most [`MAX_ZERO_SIZE_ELEMENTS`]; `slot` bytes of tree structure are charged per
-    /// element.
     fn check_len(&mut self, n: usize, min_elem_size: usize, slot: usize) -> Result<usize> {
-        if min_elem_size == 0 && n > MAX_ZERO_SIZE_ELEMENTS {
-            return Err(CdrError::new(CdrErrorKind::TooManyEmpty { len: n as u64 }));
-        }
-        self.cur.check_fits(n, min_elem_size)?;
-        self.charge(n.saturating_mul(slot))?;
-        Ok(n)
+        self.budget.check_len(&self.cur, n, min_elem_size, slot)
     }
 
-    fn charge(&mut self, bytes: usize) -> Result<()> {
-        self.budget = self.budget.checked_sub(bytes).ok_or_else(|| {
-            CdrError::new(CdrErrorKind::TreeTooLarge {
-                budget: tree_budget(self.cur.payload_len()),
-                payload: self.cur.payload_len(),
-            })
-        })?;
-        Ok(())
-    }
-
-    /// A sequence length prefix, checked like [`Reader::check_len`].
     fn seq_len(&mut self, min_elem_size: usize, slot: usize) -> Result<usize> {
-        let len = self.cur.u32()? as usize;
-        self.check_len(len, min_elem_size, slot)
+        self.budget.seq_len(&mut self.cur, min_elem_size, slot)
     }
 
     fn string(&mut self) -> Result<String> {
@@ -253,7 +257,8 @@ impl<'a> Reader<'a> {
             self.cur.u8()?;
             return Ok(Value::Struct(Vec::new()));
         }
-        self.charge(def.fields.len() * std::mem::size_of::<(Arc<str>, Value)>())?;
+        self.budget
+            .charge(def.fields.len() * std::mem::size_of::<(Arc<str>, Value)>())?;
         let mut fields = Vec::with_capacity(def.fields.len());
         for f in &def.fields {
             let min = min_wire_size(&reg.min_size, &f.ty);
@@ -299,19 +304,10 @@ impl<'a> Reader<'a> {
 
     fn read_array(&mut self, reg: &Registry, ty: &BaseType, n: usize) -> Result<Value> {
         Ok(match ty {
-            BaseType::Prim(p) => match p {
-                Prim::Bool => Value::Bools(self.cur.take(n)?.iter().map(|b| *b != 0).collect()),
-                Prim::Byte | Prim::Char | Prim::U8 => Value::Bytes(self.cur.take(n)?.to_vec()),
-                Prim::I8 => Value::I8s(self.cur.take(n)?.iter().map(|b| *b as i8).collect()),
-                Prim::I16 => read_packed!(self, n, i16, I16s),
-                Prim::U16 => read_packed!(self, n, u16, U16s),
-                Prim::I32 => read_packed!(self, n, i32, I32s),
-                Prim::U32 => read_packed!(self, n, u32, U32s),
-                Prim::I64 => read_packed!(self, n, i64, I64s),
-                Prim::U64 => read_packed!(self, n, u64, U64s),
-                Prim::F32 => read_packed!(self, n, f32, F32s),
-                Prim::F64 => read_packed!(self, n, f64, F64s),
-            },
+            BaseType::Prim(p) => {
+                let big = self.cur.is_big_endian();
+                packed_value(*p, packed_bytes(&mut self.cur, *p, n)?, big)
+            }
             _ => {
                 // `n` was checked against the bytes left and the tree budget
                 let mut items = Vec::with_capacity(n);

@@ -24,7 +24,7 @@ use std::sync::Arc;
 
 use super::super::ros2msg::{ArrayKind, BaseType, MAX_NESTING, Prim, Registry, min_wire_size};
 use super::super::value::{FieldError, Value};
-use super::{CdrError, CdrErrorKind, Cursor, MAX_ZERO_SIZE_ELEMENTS, Result, tree_budget};
+use super::{Budget, CdrError, CdrErrorKind, Cursor, Result};
 
 /// The most slots one message type may take inline: beyond it a schema is not compiled and
 /// its channel decodes to trees.
@@ -215,7 +215,7 @@ impl Flat {
             cur,
             out: self,
             depth: 0,
-            budget: tree_budget(data.len()),
+            budget: Budget::new(data.len()),
             body: &data[4..],
         };
         w.message(plan.root, 0)?;
@@ -234,7 +234,7 @@ struct Walk<'p, 'o, 'a> {
     cur: Cursor<'a>,
     out: &'o mut Flat,
     depth: usize,
-    budget: usize,
+    budget: Budget,
     body: &'a [u8],
 }
 
@@ -250,25 +250,8 @@ fn unpack(slot: u64) -> (usize, usize) {
 }
 
 impl Walk<'_, '_, '_> {
-    fn charge(&mut self, bytes: usize) -> Result<()> {
-        self.budget = self.budget.checked_sub(bytes).ok_or_else(|| {
-            CdrError::new(CdrErrorKind::TreeTooLarge {
-                budget: tree_budget(self.cur.payload_len()),
-                payload: self.cur.payload_len(),
-            })
-        })?;
-        Ok(())
-    }
-
-    /// The tree decoder's `check_len`: fits in the bytes left, bounded when elements take no
-    /// bytes, and charged `slot` bytes of structure each.
     fn check_len(&mut self, n: usize, min: usize, slot: usize) -> Result<usize> {
-        if min == 0 && n > MAX_ZERO_SIZE_ELEMENTS {
-            return Err(CdrError::new(CdrErrorKind::TooManyEmpty { len: n as u64 }));
-        }
-        self.cur.check_fits(n, min)?;
-        self.charge(n.saturating_mul(slot))?;
-        Ok(n)
+        self.budget.check_len(&self.cur, n, min, slot)
     }
 
     fn message(&mut self, d: usize, base: usize) -> Result<()> {
@@ -288,7 +271,8 @@ impl Walk<'_, '_, '_> {
             self.cur.u8()?;
             return Ok(());
         }
-        self.charge(layout.fields.len() * std::mem::size_of::<(Arc<str>, Value)>())?;
+        self.budget
+            .charge(layout.fields.len() * std::mem::size_of::<(Arc<str>, Value)>())?;
         for f in &layout.fields {
             let at = base + f.offset;
             let n = match f.array {
@@ -342,12 +326,7 @@ impl Walk<'_, '_, '_> {
     fn array(&mut self, leaf: Leaf, n: usize) -> Result<u64> {
         match leaf {
             Leaf::Packed(p) => {
-                let bytes = match p {
-                    Prim::Bool | Prim::Byte | Prim::Char | Prim::U8 | Prim::I8 => {
-                        self.cur.take(n)?
-                    }
-                    _ => self.cur.packed(n, p.size())?,
-                };
+                let bytes = super::packed_bytes(&mut self.cur, p, n)?;
                 Ok(pack(self.offset_of(bytes), n))
             }
             Leaf::Strings { wide } => {
@@ -365,11 +344,8 @@ impl Walk<'_, '_, '_> {
                 let least = n
                     .checked_mul(w)
                     .and_then(|s| s.checked_mul(std::mem::size_of::<(Arc<str>, Value)>()));
-                if least.is_none_or(|b| b > self.budget) {
-                    return Err(CdrError::new(CdrErrorKind::TreeTooLarge {
-                        budget: tree_budget(self.cur.payload_len()),
-                        payload: self.cur.payload_len(),
-                    }));
+                if least.is_none_or(|b| b > self.budget.left()) {
+                    return Err(self.budget.exceeded());
                 }
                 let first = self.out.slots.len();
                 self.out.slots.resize(first + n * w, 0);

@@ -13,7 +13,7 @@ use std::sync::Arc;
 
 use serde_json::ser::{CompactFormatter, Formatter};
 
-use super::{CdrError, CdrErrorKind, Cursor, MAX_ZERO_SIZE_ELEMENTS, Result, tree_budget};
+use super::{Budget, CdrError, CdrErrorKind, Cursor, Result};
 use crate::log::ros2msg::{ArrayKind, BaseType, MAX_NESTING, Prim, Registry, min_wire_size};
 use crate::log::value::Value;
 
@@ -30,7 +30,7 @@ pub fn write_json(
     let mut w = Writer {
         cur: Cursor::new(data)?,
         depth: 0,
-        budget: tree_budget(data.len()),
+        budget: Budget::new(data.len()),
         max: max_array,
         out: Out { buf: out, floats },
     };
@@ -94,7 +94,7 @@ struct Out<'o> {
 struct Writer<'a, 'o> {
     cur: Cursor<'a>,
     depth: usize,
-    budget: usize,
+    budget: Budget,
     max: Option<usize>,
     out: Out<'o>,
 }
@@ -173,27 +173,11 @@ macro_rules! num {
 
 impl Writer<'_, '_> {
     fn check_len(&mut self, n: usize, min_elem_size: usize, slot: usize) -> Result<usize> {
-        if min_elem_size == 0 && n > MAX_ZERO_SIZE_ELEMENTS {
-            return Err(CdrError::new(CdrErrorKind::TooManyEmpty { len: n as u64 }));
-        }
-        self.cur.check_fits(n, min_elem_size)?;
-        self.charge(n.saturating_mul(slot))?;
-        Ok(n)
-    }
-
-    fn charge(&mut self, bytes: usize) -> Result<()> {
-        self.budget = self.budget.checked_sub(bytes).ok_or_else(|| {
-            CdrError::new(CdrErrorKind::TreeTooLarge {
-                budget: tree_budget(self.cur.payload_len()),
-                payload: self.cur.payload_len(),
-            })
-        })?;
-        Ok(())
+        self.budget.check_len(&self.cur, n, min_elem_size, slot)
     }
 
     fn seq_len(&mut self, min_elem_size: usize, slot: usize) -> Result<usize> {
-        let len = self.cur.u32()? as usize;
-        self.check_len(len, min_elem_size, slot)
+        self.budget.seq_len(&mut self.cur, min_elem_size, slot)
     }
 
     fn string(&mut self) -> Result<()> {
@@ -235,7 +219,8 @@ impl Writer<'_, '_> {
             self.out.buf.extend_from_slice(b"{}");
             return Ok(());
         }
-        self.charge(def.fields.len() * std::mem::size_of::<(Arc<str>, Value)>())?;
+        self.budget
+            .charge(def.fields.len() * std::mem::size_of::<(Arc<str>, Value)>())?;
         self.out.buf.push(b'{');
         for (i, f) in def.fields.iter().enumerate() {
             if i > 0 {

@@ -3,28 +3,8 @@
 
 use super::super::super::ros2msg::{ArrayKind, Prim};
 use super::super::super::value::{FieldError, Value};
+use super::super::packed_value;
 use super::{FieldRef, FlatRef, IN_TEXT, Leaf, Plan, unpack};
-
-macro_rules! packed {
-    ($self:ident, $bytes:ident, $t:ty, $variant:ident) => {{
-        const N: usize = std::mem::size_of::<$t>();
-        let big = $self.big;
-        Value::$variant(
-            $bytes
-                .as_chunks::<N>()
-                .0
-                .iter()
-                .map(|&c| {
-                    if big {
-                        <$t>::from_be_bytes(c)
-                    } else {
-                        <$t>::from_le_bytes(c)
-                    }
-                })
-                .collect(),
-        )
-    }};
-}
 
 /// A scalar slot as its value.
 fn scalar(p: Prim, bits: u64) -> Value {
@@ -102,7 +82,7 @@ impl<'s, 'm> FlatRef<'s, 'm> {
         }
         let (first, n) = unpack(slot);
         match leaf {
-            Leaf::Packed(p) => self.packed(p, &self.body[first..first + n * p.size()]),
+            Leaf::Packed(p) => packed_value(p, &self.body[first..first + n * p.size()], self.big),
             Leaf::Strings { .. } => Value::Array(
                 (0..n)
                     .map(|i| Value::String(self.str_at(self.slots[first + i]).to_string()))
@@ -113,22 +93,6 @@ impl<'s, 'm> FlatRef<'s, 'm> {
                 Value::Array((0..n).map(|i| self.message(d, first + i * w)).collect())
             }
             Leaf::Prim(_) | Leaf::Str { .. } | Leaf::Msg(_) => Value::Null,
-        }
-    }
-
-    fn packed(&self, p: Prim, bytes: &[u8]) -> Value {
-        match p {
-            Prim::Bool => Value::Bools(bytes.iter().map(|b| *b != 0).collect()),
-            Prim::Byte | Prim::Char | Prim::U8 => Value::Bytes(bytes.to_vec()),
-            Prim::I8 => Value::I8s(bytes.iter().map(|b| *b as i8).collect()),
-            Prim::I16 => packed!(self, bytes, i16, I16s),
-            Prim::U16 => packed!(self, bytes, u16, U16s),
-            Prim::I32 => packed!(self, bytes, i32, I32s),
-            Prim::U32 => packed!(self, bytes, u32, U32s),
-            Prim::I64 => packed!(self, bytes, i64, I64s),
-            Prim::U64 => packed!(self, bytes, u64, U64s),
-            Prim::F32 => packed!(self, bytes, f32, F32s),
-            Prim::F64 => packed!(self, bytes, f64, F64s),
         }
     }
 }
