@@ -9,6 +9,7 @@ pub mod inspect;
 pub mod progress;
 pub mod run;
 pub mod score;
+pub mod submit;
 pub mod synth;
 pub mod train;
 
@@ -62,6 +63,9 @@ pub enum Command {
     /// Write a public dataset as a session log, e.g.
     /// `peopletrack import wildtrack ../shared/real/wildtrack -o wildtrack.mcap`.
     Import(import::Args),
+    /// Run one pipeline on a Slurm cluster: an array of shards, then the aggregate, e.g.
+    /// `peopletrack submit --slurm pipelines/laser_people.toml --shards 16`.
+    Submit(submit::Args),
 }
 
 /// Parse arguments, run the command, and map the outcome to an exit code:
@@ -90,6 +94,7 @@ pub fn main() -> ExitCode {
         Command::Score(a) => score::run(a, &mut out),
         Command::Train(a) => train::run(a, &mut out),
         Command::Import(a) => import::run(a, &mut out),
+        Command::Submit(a) => submit::run(a, &mut out),
     }
     .and_then(|()| out.flush().map_err(anyhow::Error::from));
     match result {

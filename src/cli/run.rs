@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use peopletrack::pipelines;
 use peopletrack::report::atomic;
-use peopletrack::run::RunOptions;
+use peopletrack::run::{RunOptions, slurm};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -20,6 +20,11 @@ pub struct Args {
     /// Process only shard K of N (1-based) and skip aggregation: for array jobs on a cluster.
     #[arg(long, value_name = "K/N", value_parser = parse_shard)]
     pub shard: Option<(usize, usize)>,
+    /// Take the shard from the scheduler: a Slurm array task (SLURM_ARRAY_TASK_ID of
+    /// SLURM_ARRAY_TASK_COUNT) or a Kubernetes indexed job (JOB_COMPLETION_INDEX of
+    /// PEOPLETRACK_SHARDS). `peopletrack submit --slurm` writes jobs that use it.
+    #[arg(long, conflicts_with_all = ["shard", "aggregate_only"])]
+    pub shard_from_env: bool,
     /// Aggregate cached per-session results only (after all shards ran).
     #[arg(long, conflicts_with = "shard")]
     pub aggregate_only: bool,
@@ -73,7 +78,10 @@ pub fn options(a: &Args, progress: bool) -> RunOptions {
 }
 
 pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
-    let opts = options(a, super::stderr_is_terminal());
+    let mut opts = options(a, super::stderr_is_terminal());
+    if a.shard_from_env {
+        opts.shard = Some(slurm::shard_from_env(|k| std::env::var(k).ok())?);
+    }
     if !a.dry_run {
         atomic::sweep_scratch(&a.out)?;
     }

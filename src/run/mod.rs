@@ -21,7 +21,9 @@
 mod cache;
 pub mod config;
 pub mod report;
+pub mod shard;
 pub mod skipped;
+pub mod slurm;
 
 use std::collections::BTreeMap;
 use std::panic::{self, AssertUnwindSafe};
