@@ -184,6 +184,7 @@ fn options(out: &Path, sessions: Vec<String>) -> RunOptions {
         progress: None,
         write_tracks: None,
         recover: false,
+        keep_going: false,
     }
 }
 

@@ -21,6 +21,7 @@ fn opts(out: &Path) -> RunOptions {
         progress: None,
         write_tracks: None,
         recover: false,
+        keep_going: false,
     }
 }
 

@@ -94,6 +94,7 @@ fn options(out: &Path) -> RunOptions {
         progress: None,
         write_tracks: None,
         recover: false,
+        keep_going: false,
     }
 }
 

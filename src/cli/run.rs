@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use peopletrack::pipelines;
 use peopletrack::report::atomic;
-use peopletrack::run::RunOptions;
+use peopletrack::run::{RunOptions, skipped};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -40,6 +40,11 @@ pub struct Args {
     /// report, its results kept.
     #[arg(long)]
     pub recover: bool,
+    /// Do not fail the run when a session's results, computed, cannot be stored in the cache
+    /// (a full disk, a read-only cache folder): they are still in this run's tables and the
+    /// session is listed as `unstored` in the `skipped_sessions` table.
+    #[arg(long)]
+    pub keep_going: bool,
 }
 
 fn parse_shard(s: &str) -> Result<(usize, usize), String> {
@@ -69,6 +74,16 @@ pub fn options(a: &Args, progress: bool) -> RunOptions {
             .as_ref()
             .map(|d| d.clone().unwrap_or_else(|| a.out.join("tracks"))),
         recover: a.recover,
+        keep_going: a.keep_going,
+    }
+}
+
+/// How a session kept with a warning was kept (for the warning line).
+pub fn kept_how(why: &str) -> &'static str {
+    if skipped::warned_status(why) == skipped::UNSTORED {
+        "not stored in the cache"
+    } else {
+        "read with warnings"
     }
 }
 
@@ -80,6 +95,9 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     let s = pipelines::run_file(&a.pipeline, &opts)?;
     if a.dry_run {
         write!(out, "{}", s.plan)?;
+        for n in &s.notices {
+            eprintln!("warning: {n}");
+        }
         return Ok(());
     }
     writeln!(
@@ -102,7 +120,10 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         eprintln!("warning: skipped {session}: {why}");
     }
     for (session, why) in &s.warned {
-        eprintln!("warning: {session} read with warnings (results kept): {why}");
+        eprintln!("warning: {session} {} (results kept): {why}", kept_how(why));
+    }
+    for n in &s.notices {
+        eprintln!("warning: {n}");
     }
     Ok(())
 }

@@ -127,6 +127,7 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         progress: super::progress::shared(super::stderr_is_terminal()),
         write_tracks: None,
         recover: false,
+        keep_going: false,
     };
     atomic::sweep_scratch(&a.out)?;
     let s = pipelines::run_file(&a.config, &opts)?;

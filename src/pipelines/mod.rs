@@ -84,6 +84,7 @@ mod tests {
                 progress: None,
                 write_tracks: None,
                 recover: false,
+                keep_going: false,
             };
             if let Err(e) = run_file(&path, &opts) {
                 let msg = format!("{e:#}");

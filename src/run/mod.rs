@@ -16,10 +16,20 @@
 //! `process`) is skipped, counted and listed with its reason in the run summary, in the
 //! pipeline's `skipped_sessions` table ([`skipped`], written by the runner for every pipeline)
 //! and in the report — never silently dropped; the other sessions' results are kept. The cache lives in `cache`
-//! (`--aggregate-only` reads it without the logs).
+//! (`--aggregate-only` reads it without the logs). A session computed but whose results could
+//! not be stored in the cache keeps its results in this run's tables, is listed (`unstored`,
+//! with the cache path and the reason) and fails the run unless `--keep-going`.
+//!
+//! Runs that share an output folder: a run that writes a pipeline's products (a full run or
+//! `--aggregate-only`) holds `out/<pipeline>/.lock` ([`lock`]) from its plan to its end, so a
+//! second one fails at once naming the folder and the holder's process id; shards only store
+//! sessions (complete or absent, by rename) and take no lock; every process writes its scratch
+//! files in its own folder ([`crate::report::atomic`]).
 
 mod cache;
 pub mod config;
+mod inputs;
+pub mod lock;
 pub mod report;
 pub mod skipped;
 
@@ -108,6 +118,13 @@ pub trait Experiment: Sync {
         Vec::new()
     }
 
+    /// Files the parameters name that must exist before anything runs (e.g. a model to
+    /// load): `(key path within [params], path)`. A missing one is an error naming the
+    /// pipeline file, the key's line and the path, in `--dry-run` too.
+    fn required_files(_params: &Self::Params) -> Vec<(String, PathBuf)> {
+        Vec::new()
+    }
+
     /// Process one session into named tables.
     fn process(
         session: &Session,
@@ -142,6 +159,9 @@ pub struct RunOptions {
     /// Read damaged logs as far as they go (`--recover`): every complete chunk before the
     /// damage (and good chunks after it); what was lost is listed per session.
     pub recover: bool,
+    /// `--keep-going`: a session computed but whose results could not be stored in the cache
+    /// does not fail the run (it is still listed, `unstored`).
+    pub keep_going: bool,
 }
 
 /// What a run did, for the report.
@@ -169,6 +189,9 @@ pub struct RunSummary {
     pub seconds: f64,
     /// Dry-run plan text (empty for real runs).
     pub plan: String,
+    /// Warnings about the run as a whole (a `[topics]` remap no session has, a folder that
+    /// could not be locked), each naming the file or folder.
+    pub notices: Vec<String>,
 }
 
 /// Check that a session has every required topic.
@@ -188,6 +211,7 @@ fn plan_text<E: Experiment>(
     file: &PipelineFile<E::Params>,
     sessions: &[SessionRef],
     stages: &[Stage],
+    notices: &[String],
 ) -> String {
     use std::fmt::Write;
     let mut o = String::new();
@@ -248,6 +272,9 @@ fn plan_text<E: Experiment>(
             s.path.display()
         );
     }
+    for n in notices {
+        let _ = writeln!(o, "warning: {n}");
+    }
     o
 }
 
@@ -279,6 +306,7 @@ fn plan<E: Experiment>(
     opts: &RunOptions,
 ) -> anyhow::Result<Plan<E::Params>> {
     let (file, stages) = check_experiment::<E>(path, text)?;
+    inputs::check_required(path, text, &E::required_files(&file.params))?;
     let patterns = opts
         .sessions
         .clone()
@@ -351,6 +379,8 @@ struct SessionResult {
     tables: SessionTables,
     cached: bool,
     warnings: Vec<String>,
+    /// Why its results, computed, could not be stored in the cache (naming the path).
+    not_stored: Option<String>,
 }
 
 /// Step 2, one session: its cached tables when the key matches, else `process` (then cached).
@@ -376,6 +406,7 @@ fn session_tables<E: Experiment>(
             tables,
             cached: true,
             warnings,
+            not_stored: None,
         });
     }
     if opts.aggregate_only {
@@ -395,18 +426,21 @@ fn session_tables<E: Experiment>(
         result => (result?, log),
     };
     let warnings = log.summary().warnings.clone();
-    cache::store(
+    let not_stored = cache::store(
         &opts.out,
         &dir,
         &key,
         (&s.path, file_hash),
         (&tables, &warnings),
         job.provenance,
-    )?;
+    )
+    .err()
+    .map(|e| format!("{}{}: {e:#}", skipped::NOT_STORED, dir.display()));
     Ok(SessionResult {
         tables,
         cached: false,
         warnings,
+        not_stored,
     })
 }
 
@@ -523,6 +557,45 @@ fn write_products(
     Ok(())
 }
 
+/// What step 2 gave, sorted for the later steps.
+#[derive(Default)]
+struct Collected {
+    /// Sessions with results.
+    done: Vec<(SessionRef, SessionTables)>,
+    /// Sessions without results, and why.
+    not_done: Vec<(SessionRef, String)>,
+    /// Sessions with results and a warning: read with warnings, or not stored in the cache.
+    warned: Vec<(SessionRef, String)>,
+}
+
+/// Sort the sessions' outcomes into results, skips and warnings, counted in `summary`.
+fn collect(outcomes: Vec<Outcome>, summary: &mut RunSummary) -> Collected {
+    let mut c = Collected::default();
+    let label = |s: &SessionRef| format!("{}/{}", s.dataset, s.name);
+    for outcome in outcomes {
+        match outcome {
+            Ok((s, result)) => {
+                if result.cached {
+                    summary.cached += 1;
+                } else {
+                    summary.computed += 1;
+                }
+                let warnings = (!result.warnings.is_empty()).then(|| result.warnings.join("; "));
+                for why in warnings.into_iter().chain(result.not_stored) {
+                    summary.warned.push((label(&s), why.clone()));
+                    c.warned.push((s.clone(), why));
+                }
+                c.done.push((s, result.tables));
+            }
+            Err((s, reason)) => {
+                summary.skipped.push((label(&s), reason.clone()));
+                c.not_done.push((s, reason));
+            }
+        }
+    }
+    c
+}
+
 /// Run one pipeline file end to end with experiment `E`: plan, per-session processing
 /// (cached), aggregation, and writing of its products.
 pub fn run_experiment<E: Experiment>(
@@ -550,13 +623,29 @@ pub fn run_experiment<E: Experiment>(
         artifacts: Vec::new(),
         seconds: 0.0,
         plan: String::new(),
+        notices: Vec::new(),
     };
-    if opts.dry_run {
-        summary.plan = plan_text::<E>(file, &plan.sessions, &plan.stages);
-        return Ok(summary);
-    }
     if plan.sessions.is_empty() {
         anyhow::bail!("{}: no sessions match {:?}", path.display(), plan.patterns);
+    }
+    // a run that writes the pipeline's products holds its folder from here to its end
+    let held = if opts.dry_run || opts.shard.is_some() {
+        None
+    } else {
+        Some(lock::FolderLock::acquire(&opts.out.join(&name))?)
+    };
+    summary
+        .notices
+        .extend(held.as_ref().and_then(|l| l.unsupported.clone()));
+    summary.notices.extend(inputs::absent_topics(
+        path,
+        text,
+        &file.topics,
+        &plan.sessions,
+    ));
+    if opts.dry_run {
+        summary.plan = plan_text::<E>(file, &plan.sessions, &plan.stages, &summary.notices);
+        return Ok(summary);
     }
     let params_json = serde_json::to_string(&file.params)?;
     let topics_json = serde_json::to_string(&file.topics)?;
@@ -575,39 +664,13 @@ pub fn run_experiment<E: Experiment>(
         provenance: &provenance,
         bars: reporter(&opts.progress),
     };
-    let mut done = Vec::new();
-    let mut not_done = Vec::new();
-    let mut warned = Vec::new();
-    for outcome in process_sessions::<E>(&job) {
-        match outcome {
-            Ok((s, result)) => {
-                if result.cached {
-                    summary.cached += 1;
-                } else {
-                    summary.computed += 1;
-                }
-                if !result.warnings.is_empty() {
-                    let why = result.warnings.join("; ");
-                    summary
-                        .warned
-                        .push((format!("{}/{}", s.dataset, s.name), why.clone()));
-                    warned.push((s.clone(), why));
-                }
-                done.push((s, result.tables));
-            }
-            Err((s, reason)) => {
-                summary
-                    .skipped
-                    .push((format!("{}/{}", s.dataset, s.name), reason.clone()));
-                not_done.push((s, reason));
-            }
-        }
-    }
+    let c = collect(process_sessions::<E>(&job), &mut summary);
     if opts.shard.is_some() {
         summary.seconds = started.elapsed().as_secs_f64();
+        skipped::fail_if_unstored(&summary, opts)?;
         return Ok(summary);
     }
-    if done.is_empty() {
+    if c.done.is_empty() {
         anyhow::bail!(
             "{}: every session was skipped; first: {}",
             path.display(),
@@ -620,21 +683,23 @@ pub fn run_experiment<E: Experiment>(
     // step 3: aggregate
     let products = E::aggregate(
         &Aggregate {
-            sessions: &done,
+            sessions: &c.done,
             provenance: provenance.clone(),
             write_tracks: opts.write_tracks.as_deref(),
         },
         &file.params,
     )?;
-    write_products(products, &opts.out, &provenance, &mut summary)?;
-    let skipped_table = skipped::table(&not_done, &warned, &provenance)?;
-    write_table(
-        &opts.out.join(&name).join("tables"),
-        &skipped_table,
-        &opts.out,
-    )?;
+    let skipped_table = skipped::table(&c.not_done, &c.warned, &provenance)?;
+    write_products(products, &opts.out, &provenance, &mut summary)
+        .and_then(|()| {
+            let tables = opts.out.join(&name).join("tables");
+            Ok(write_table(&tables, &skipped_table, &opts.out).map(|_| ())?)
+        })
+        .map_err(|e| skipped::also_unstored(e, &summary))?;
     summary.skipped_table = format!("{name}/tables/{}.md", skipped::TABLE);
     summary.seconds = started.elapsed().as_secs_f64();
+    skipped::fail_if_unstored(&summary, opts)?;
+    drop(held);
     Ok(summary)
 }
 

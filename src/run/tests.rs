@@ -77,6 +77,7 @@ fn options(out: &Path) -> RunOptions {
         progress: None,
         write_tracks: None,
         recover: false,
+        keep_going: false,
     }
 }
 

@@ -4,6 +4,13 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use peopletrack::Nanos;
+use peopletrack::groundtruth::{
+    PEOPLE_JSON_SCHEMA, PEOPLE_SCHEMA, PEOPLE_TOPIC, PeopleFrame, PersonTruth,
+};
+use peopletrack::log::msgs::{Header, LaserScan};
+use peopletrack::log::{SessionWriter, WriterOptions};
+
 /// `../shared/real/<rel>` beside the project, or `None` (with a clear message on stderr) when
 /// that folder is absent. The real data is read in place, never copied into the project.
 pub fn real(rel: &str) -> Option<PathBuf> {
@@ -45,4 +52,62 @@ pub fn csv(path: &Path) -> Vec<BTreeMap<String, String>> {
                 .collect()
         })
         .collect()
+}
+
+/// Three small sessions in two datasets (`lab/a`, `lab/b`, `park/c`), with scans and ground
+/// truth, for runs of `pipelines/dataset_quality.toml`; returns the glob that finds them.
+pub fn runner_sessions(dir: &Path) -> String {
+    for (dataset, name, n) in [("lab", "a", 40u64), ("lab", "b", 60), ("park", "c", 50)] {
+        let p = dir.join(dataset).join(format!("{name}.mcap"));
+        let mut w = SessionWriter::create(&p, &WriterOptions::default()).expect("create");
+        let scan = w.add_ros2::<LaserScan>("/scan").expect("scan");
+        let gt = w
+            .add_json(PEOPLE_TOPIC, PEOPLE_SCHEMA, PEOPLE_JSON_SCHEMA)
+            .expect("gt");
+        for i in 0..n {
+            let t = Nanos(1_000_000_000 + i * 100_000_000);
+            let msg = LaserScan {
+                header: Header::new(Nanos(t.0 - 5_000_000), "laser"),
+                ranges: vec![1.0; 10],
+                range_max: 10.0,
+                ..Default::default()
+            };
+            w.write(scan, t, &msg).expect("scan");
+            let frame = PeopleFrame {
+                stamp_ns: t.0,
+                people: vec![PersonTruth {
+                    id: 1,
+                    x: i as f64 * 0.1,
+                    y: 0.0,
+                    vx: 1.0,
+                    vy: 0.0,
+                    height: 1.8,
+                    head_z: 1.7,
+                    radius: 0.2,
+                    legs: [[0.0, 0.1], [0.0, -0.1]],
+                    leg_radius: 0.06,
+                    cameras: vec![],
+                }],
+            };
+            w.write_json(gt, t, &frame).expect("gt");
+        }
+        w.finish().expect("finish");
+    }
+    format!("{}/*/*.mcap", dir.display())
+}
+
+/// Every file under `out/<pipeline>/tables` and `figures`, with its bytes.
+pub fn products(out: &Path, pipeline: &str) -> BTreeMap<String, Vec<u8>> {
+    let mut m = BTreeMap::new();
+    for sub in ["tables", "figures"] {
+        let d = out.join(pipeline).join(sub);
+        for e in std::fs::read_dir(&d).unwrap_or_else(|e| panic!("{}: {e}", d.display())) {
+            let p = e.expect("entry").path();
+            m.insert(
+                format!("{sub}/{}", p.file_name().expect("name").to_string_lossy()),
+                std::fs::read(&p).expect("read"),
+            );
+        }
+    }
+    m
 }
