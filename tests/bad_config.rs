@@ -22,12 +22,14 @@ fn dry_run(out: &Path) -> RunOptions {
         dry_run: true,
         shard: None,
         aggregate_only: false,
+        expect_shards: None,
         force: false,
         out: out.to_path_buf(),
         git_commit: "test".into(),
         progress: None,
         write_tracks: None,
         recover: false,
+        keep_going: false,
     }
 }
 
@@ -162,6 +164,9 @@ fn unknown_topic_keys_are_errors_naming_them() {
         "ground_truth = \"/ground_truth/people\"",
         "ground_truth = \"/ground_truth/people\"\ncam_3_image = \"/c3\"",
     );
+    // a dry run needs a session to plan (a glob that matches nothing is an error)
+    std::fs::create_dir_all(dir.path().join("none")).expect("mkdir");
+    std::fs::write(dir.path().join("none/s.mcap"), b"not opened by a dry run").expect("write");
     run_file(&write(dir.path(), "ok.toml", &ok), &dry_run(dir.path())).expect("a known name");
     check(
         "s004_mohedano_multicam",

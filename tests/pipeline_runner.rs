@@ -4,13 +4,10 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+mod common;
+
 use assert_cmd::Command;
-use peopletrack::Nanos;
-use peopletrack::groundtruth::{
-    PEOPLE_JSON_SCHEMA, PEOPLE_SCHEMA, PEOPLE_TOPIC, PeopleFrame, PersonTruth,
-};
-use peopletrack::log::msgs::{Header, LaserScan};
-use peopletrack::log::{SessionWriter, WriterOptions};
+use common::runner_sessions as fixtures;
 
 fn peopletrack() -> Command {
     Command::cargo_bin("peopletrack").expect("binary")
@@ -18,47 +15,6 @@ fn peopletrack() -> Command {
 
 fn pipeline() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("pipelines/dataset_quality.toml")
-}
-
-/// Three small sessions in two datasets, with scans and ground truth.
-fn fixtures(dir: &Path) -> String {
-    for (dataset, name, n) in [("lab", "a", 40u64), ("lab", "b", 60), ("park", "c", 50)] {
-        let p = dir.join(dataset).join(format!("{name}.mcap"));
-        let mut w = SessionWriter::create(&p, &WriterOptions::default()).expect("create");
-        let scan = w.add_ros2::<LaserScan>("/scan").expect("scan");
-        let gt = w
-            .add_json(PEOPLE_TOPIC, PEOPLE_SCHEMA, PEOPLE_JSON_SCHEMA)
-            .expect("gt");
-        for i in 0..n {
-            let t = Nanos(1_000_000_000 + i * 100_000_000);
-            let msg = LaserScan {
-                header: Header::new(Nanos(t.0 - 5_000_000), "laser"),
-                ranges: vec![1.0; 10],
-                range_max: 10.0,
-                ..Default::default()
-            };
-            w.write(scan, t, &msg).expect("scan");
-            let frame = PeopleFrame {
-                stamp_ns: t.0,
-                people: vec![PersonTruth {
-                    id: 1,
-                    x: i as f64 * 0.1,
-                    y: 0.0,
-                    vx: 1.0,
-                    vy: 0.0,
-                    height: 1.8,
-                    head_z: 1.7,
-                    radius: 0.2,
-                    legs: [[0.0, 0.1], [0.0, -0.1]],
-                    leg_radius: 0.06,
-                    cameras: vec![],
-                }],
-            };
-            w.write_json(gt, t, &frame).expect("gt");
-        }
-        w.finish().expect("finish");
-    }
-    format!("{}/*/*.mcap", dir.display())
 }
 
 fn run(out: &Path, sessions: &str, extra: &[&str]) -> std::process::Output {
@@ -74,18 +30,7 @@ fn run(out: &Path, sessions: &str, extra: &[&str]) -> std::process::Output {
 
 /// Every file under out/<pipeline>/tables and figures, with its bytes.
 fn outputs(out: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut m = BTreeMap::new();
-    for sub in ["tables", "figures"] {
-        let d = out.join("dataset_quality").join(sub);
-        for e in std::fs::read_dir(&d).expect("outputs exist") {
-            let p = e.expect("entry").path();
-            m.insert(
-                format!("{sub}/{}", p.file_name().expect("name").to_string_lossy()),
-                std::fs::read(&p).expect("read"),
-            );
-        }
-    }
-    m
+    common::products(out, "dataset_quality")
 }
 
 #[test]
@@ -185,7 +130,8 @@ fn a_run_killed_midway_leaves_no_partial_file() {
                 .expect("inside")
                 .to_string_lossy()
                 .into_owned();
-            if rel.starts_with(".tmp") {
+            // scratch files, and the run's lock files (not outputs)
+            if rel.starts_with(".tmp") || rel.ends_with(".lock") || rel.ends_with(".lock.guard") {
                 continue;
             }
             let bytes = std::fs::read(&e).expect("read");

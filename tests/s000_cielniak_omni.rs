@@ -15,12 +15,14 @@ fn opts(out: &Path) -> RunOptions {
         dry_run: false,
         shard: None,
         aggregate_only: false,
+        expect_shards: None,
         force: false,
         out: out.to_path_buf(),
         git_commit: "test".into(),
         progress: None,
         write_tracks: None,
         recover: false,
+        keep_going: false,
     }
 }
 

@@ -9,6 +9,7 @@ use anyhow::Context;
 
 use peopletrack::pipelines;
 use peopletrack::report::atomic;
+use peopletrack::run::lock::FolderLock;
 use peopletrack::run::{RunOptions, report};
 
 #[derive(Debug, clap::Args)]
@@ -30,6 +31,10 @@ pub struct Args {
     /// Output root (default `out`, or `out/full` for the full profile).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Do not fail when a session's results, computed, cannot be stored in the cache (as
+    /// `run --keep-going`).
+    #[arg(long)]
+    pub keep_going: bool,
 }
 
 /// `datasets/x/*.mcap` -> `datasets/x/full/*.mcap`: the same glob one folder down.
@@ -82,18 +87,25 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
             "out"
         })
     });
+    // one eval per output root: it writes REPORT.md from every pipeline's tables
+    let held = FolderLock::acquire(&out_root)?;
+    if let Some(n) = &held.unsupported {
+        eprintln!("warning: {n}");
+    }
     atomic::sweep_scratch(&out_root)?;
     let base = RunOptions {
         sessions: None,
         dry_run: false,
         shard: None,
         aggregate_only: false,
+        expect_shards: None,
         force: a.force,
         out: out_root.clone(),
         git_commit: super::git_commit(),
         progress: super::progress::shared(super::stderr_is_terminal()),
         write_tracks: None,
         recover: false,
+        keep_going: a.keep_going,
     };
     let mut runs = Vec::new();
     for f in &files {
@@ -117,17 +129,22 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
             eprintln!("warning: {}: skipped {session}: {why}", s.pipeline);
         }
         for (session, why) in &s.warned {
+            let how = super::run::kept_how(why);
             eprintln!(
-                "warning: {}: {session} read with warnings (results kept): {why}",
+                "warning: {}: {session} {how} (results kept): {why}",
                 s.pipeline
             );
+        }
+        for n in &s.notices {
+            eprintln!("warning: {}: {n}", s.pipeline);
         }
         runs.push(s);
     }
     let mut tables = BTreeMap::new();
     for (_, path) in runs.iter().flat_map(|r| r.tables.iter()) {
-        let text = std::fs::read_to_string(out_root.join(path))
-            .with_context(|| format!("reading {path}"))?;
+        let file = out_root.join(path);
+        let text = std::fs::read_to_string(&file)
+            .with_context(|| format!("reading table {}", file.display()))?;
         tables.insert(path.clone(), text);
     }
     let header = report::Header {
@@ -138,8 +155,10 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     };
     let md = report::render(&runs, &tables, &header);
     let path = out_root.join("REPORT.md");
-    atomic::write_atomic(&path, md.as_bytes(), Some(&out_root))?;
+    atomic::write_atomic(&path, md.as_bytes(), Some(&out_root))
+        .with_context(|| format!("writing the report to {}", path.display()))?;
     writeln!(out, "wrote {}", path.display())?;
+    drop(held);
     Ok(())
 }
 

@@ -27,6 +27,11 @@ pub struct Cli {
     /// depend on it.
     #[arg(long, short = 'j', global = true, value_name = "N")]
     pub jobs: Option<usize>,
+    /// Most MiB of structure (fields and array slots) one decoded message may take, for any
+    /// command that decodes messages (default: 16 MiB plus 8 bytes per payload byte). Raise
+    /// it for a valid message the default refuses, e.g. millions of one-byte structs.
+    #[arg(long, global = true, value_name = "MIB")]
+    pub max_structure_mib: Option<usize>,
     /// Crash test: abort just before the N-th file replacement (hidden; for tests).
     #[arg(long, global = true, hide = true, value_name = "N")]
     pub debug_abort_after_writes: Option<u64>,
@@ -83,6 +88,9 @@ pub fn main() -> ExitCode {
     if let Some(n) = cli.debug_abort_after_writes {
         peopletrack::report::atomic::abort_before_rename(n);
     }
+    if let Some(mib) = cli.max_structure_mib {
+        peopletrack::log::cdr::set_structure_limit(Some(mib.saturating_mul(1 << 20)));
+    }
     let stdout = io::stdout();
     let mut out = io::BufWriter::new(stdout.lock());
     let result = match &cli.command {
@@ -97,6 +105,8 @@ pub fn main() -> ExitCode {
         Command::Submit(a) => submit::run(a, &mut out),
     }
     .and_then(|()| out.flush().map_err(anyhow::Error::from));
+    // this process's scratch folders (empty once every write is done) go
+    peopletrack::report::atomic::release_scratch();
     match result {
         Ok(()) => ExitCode::SUCCESS,
         // `peopletrack cat ... | head` closes the pipe early: not an error

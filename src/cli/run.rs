@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use peopletrack::pipelines;
 use peopletrack::report::atomic;
-use peopletrack::run::{RunOptions, slurm};
+use peopletrack::run::{RunOptions, skipped, slurm};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -28,6 +28,12 @@ pub struct Args {
     /// Aggregate cached per-session results only (after all shards ran).
     #[arg(long, conflicts_with = "shard")]
     pub aggregate_only: bool,
+    /// With --aggregate-only: all N shards of a sharded run must have left their record
+    /// (`out/<pipeline>/shards/N/K.json`); a shard that did not finish, ran another
+    /// configuration or left a damaged record is named and nothing is aggregated. The sessions
+    /// a shard skipped are reported with the shard's reason, even with the logs gone.
+    #[arg(long, value_name = "N", requires = "aggregate_only", value_parser = clap::value_parser!(u32).range(1..))]
+    pub expect_shards: Option<u32>,
     /// Recompute sessions even when a cached result matches.
     #[arg(long)]
     pub force: bool,
@@ -45,6 +51,11 @@ pub struct Args {
     /// report, its results kept.
     #[arg(long)]
     pub recover: bool,
+    /// Do not fail the run when a session's results, computed, cannot be stored in the cache
+    /// (a full disk, a read-only cache folder): they are still in this run's tables and the
+    /// session is listed as `unstored` in the `skipped_sessions` table.
+    #[arg(long)]
+    pub keep_going: bool,
 }
 
 fn parse_shard(s: &str) -> Result<(usize, usize), String> {
@@ -65,6 +76,7 @@ pub fn options(a: &Args, progress: bool) -> RunOptions {
         dry_run: a.dry_run,
         shard: a.shard,
         aggregate_only: a.aggregate_only,
+        expect_shards: a.expect_shards.map(|n| n as usize),
         force: a.force,
         out: a.out.clone(),
         git_commit: super::git_commit(),
@@ -74,6 +86,16 @@ pub fn options(a: &Args, progress: bool) -> RunOptions {
             .as_ref()
             .map(|d| d.clone().unwrap_or_else(|| a.out.join("tracks"))),
         recover: a.recover,
+        keep_going: a.keep_going,
+    }
+}
+
+/// How a session kept with a warning was kept (for the warning line).
+pub fn kept_how(why: &str) -> &'static str {
+    if skipped::warned_status(why) == skipped::UNSTORED {
+        "not stored in the cache"
+    } else {
+        "read with warnings"
     }
 }
 
@@ -88,6 +110,9 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     let s = pipelines::run_file(&a.pipeline, &opts)?;
     if a.dry_run {
         write!(out, "{}", s.plan)?;
+        for n in &s.notices {
+            eprintln!("warning: {n}");
+        }
         return Ok(());
     }
     writeln!(
@@ -110,7 +135,10 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         eprintln!("warning: skipped {session}: {why}");
     }
     for (session, why) in &s.warned {
-        eprintln!("warning: {session} read with warnings (results kept): {why}");
+        eprintln!("warning: {session} {} (results kept): {why}", kept_how(why));
+    }
+    for n in &s.notices {
+        eprintln!("warning: {n}");
     }
     Ok(())
 }

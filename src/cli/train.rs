@@ -121,12 +121,14 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
         dry_run: false,
         shard: None,
         aggregate_only: false,
+        expect_shards: None,
         force: a.force,
         out: a.out.clone(),
         git_commit: super::git_commit(),
         progress: super::progress::shared(super::stderr_is_terminal()),
         write_tracks: None,
         recover: false,
+        keep_going: false,
     };
     atomic::sweep_scratch(&a.out)?;
     let s = pipelines::run_file(&a.config, &opts)?;

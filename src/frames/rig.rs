@@ -12,7 +12,7 @@ use crate::time::Nanos;
 /// Why a camera could not be calibrated; every variant names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum RigError {
-    #[error("{0}")]
+    #[error(transparent)]
     Log(#[from] LogError),
     #[error("{file}: no CameraInfo on {topic} (camera {camera})")]
     NoCameraInfo {
@@ -20,21 +20,22 @@ pub enum RigError {
         topic: String,
         camera: String,
     },
-    #[error("{file}: {topic}: camera {camera}: {source}")]
+    // `error`, not `source`: a source would be printed twice in an error chain
+    #[error("{file}: {topic}: camera {camera}: {error}")]
     Model {
         file: String,
         topic: String,
         camera: String,
-        source: Box<CameraError>,
+        error: Box<CameraError>,
     },
-    #[error("{file}: no transform {world} <- {frame} (camera {camera}) at {at} s: {source}")]
+    #[error("{file}: no transform {world} <- {frame} (camera {camera}) at {at} s: {error}")]
     NoPose {
         file: String,
         camera: String,
         frame: String,
         world: String,
         at: Nanos,
-        source: Box<TfError>,
+        error: Box<TfError>,
     },
 }
 
@@ -93,13 +94,13 @@ pub fn camera(
     let at = at.unwrap_or_else(|| info.header.stamp.nanos().unwrap_or(Nanos(0)));
     let world_from_camera =
         tf.lookup(world_frame, &frame, at)
-            .map_err(|source| RigError::NoPose {
+            .map_err(|error| RigError::NoPose {
                 file: log.path().display().to_string(),
                 camera: camera.to_string(),
                 frame: frame.clone(),
                 world: world_frame.to_string(),
                 at,
-                source: Box::new(source),
+                error: Box::new(error),
             })?;
     Ok(RigCamera {
         name: camera.to_string(),
@@ -120,11 +121,11 @@ pub fn views(
         .iter()
         .map(|(name, topic)| {
             let cam = camera(log, tf, name, topic, world_frame, None)?;
-            let model = cam.model().map_err(|source| RigError::Model {
+            let model = cam.model().map_err(|error| RigError::Model {
                 file: log.path().display().to_string(),
                 topic: topic.clone(),
                 camera: name.clone(),
-                source: Box::new(source),
+                error: Box::new(error),
             })?;
             Ok(CalibratedView::new(model, cam.world_from_camera))
         })

@@ -22,6 +22,7 @@
 //! Written by hand: the only Rust CDR crate (`cdr`) needs compile-time serde types.
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use super::ros2msg::{ArrayKind, BaseType, MAX_NESTING, Prim, Registry, min_wire_size};
 use super::value::Value;
@@ -32,12 +33,44 @@ pub const MAX_ZERO_SIZE_ELEMENTS: usize = 1 << 16;
 
 /// Bytes the decoded tree's structure (struct fields and array slots, not the packed numbers,
 /// bytes and strings, which the payload bounds) may take for a payload of `payload_len`
-/// bytes: 16 MiB plus 8 per payload byte. A dense `geometry_msgs/Point[]` takes about 7.3
-/// bytes of structure per wire byte, so real messages fit; an array of one-byte structs
-/// (about 80) is refused instead of taking a hundred times its size in memory.
+/// bytes: by default ([`default_tree_budget`]) 16 MiB plus 8 per payload byte, or the limit
+/// set for the process ([`set_structure_limit`], the CLI's `--max-structure-mib`).
 pub fn tree_budget(payload_len: usize) -> usize {
+    budget_for(payload_len, structure_limit())
+}
+
+/// The default structure budget: 16 MiB plus 8 bytes per payload byte. A dense
+/// `geometry_msgs/Point[]` takes about 7.3 bytes of structure per wire byte, so real messages
+/// fit; an array of one-byte structs (about 80) is refused instead of taking a hundred times
+/// its size in memory — unless the user raises the limit.
+pub fn default_tree_budget(payload_len: usize) -> usize {
     (16usize << 20).saturating_add(payload_len.saturating_mul(8))
 }
+
+/// The structure budget of a payload under `limit` (bytes), or the default without one.
+pub fn budget_for(payload_len: usize, limit: Option<usize>) -> usize {
+    limit.unwrap_or_else(|| default_tree_budget(payload_len))
+}
+
+/// The process-wide structure limit in bytes; 0 = the default rule.
+static STRUCTURE_LIMIT: AtomicUsize = AtomicUsize::new(0);
+
+/// Set (or, with `None`, clear) the structure limit of every decode in this process: set once
+/// by the CLI from `--max-structure-mib`, before anything is decoded (like the thread count).
+pub fn set_structure_limit(bytes: Option<usize>) {
+    STRUCTURE_LIMIT.store(bytes.map_or(0, |b| b.max(1)), Ordering::Relaxed);
+}
+
+/// The structure limit set for this process, if any.
+pub fn structure_limit() -> Option<usize> {
+    match STRUCTURE_LIMIT.load(Ordering::Relaxed) {
+        0 => None,
+        n => Some(n),
+    }
+}
+
+/// What a refused message's error says to raise the budget.
+pub const RAISE_HINT: &str = "--max-structure-mib raises this limit";
 
 /// Byte order of a CDR payload.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -87,7 +120,7 @@ pub enum CdrErrorKind {
     )]
     TooManyEmpty { len: u64 },
     #[error(
-        "decoded message would take more than {budget} bytes of structure (payload {payload} bytes)"
+        "decoded message would take more than {budget} bytes of structure (payload {payload} bytes; {RAISE_HINT})"
     )]
     TreeTooLarge { budget: usize, payload: usize },
 }

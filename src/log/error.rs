@@ -13,8 +13,9 @@ use super::value::FieldError;
 /// What went wrong.
 #[derive(Debug, thiserror::Error)]
 pub enum LogErrorKind {
+    // no `#[from]`: a source would be printed twice in an error chain (`From` is below)
     #[error("{0}")]
-    Io(#[from] std::io::Error),
+    Io(std::io::Error),
     #[error("not an MCAP file (the first bytes are not the MCAP magic)")]
     NotMcap,
     #[error("file is truncated: {what} at byte {offset} needs {needed} bytes but the file ends at byte {file_len}{}",
@@ -97,8 +98,22 @@ pub enum LogErrorKind {
     WrongType { expected: String, found: String },
     #[error("no topic `{0}` in the log")]
     MissingTopic(String),
+    #[error(
+        "no topic `{topic}` in the part of the log that could be read (its topics: {present}): its channel record was in what is lost ({lost}), or the log never had it"
+    )]
+    MissingTopicInRecovered {
+        topic: String,
+        present: String,
+        lost: String,
+    },
     #[error("{0}")]
     Write(String),
+}
+
+impl From<std::io::Error> for LogErrorKind {
+    fn from(e: std::io::Error) -> Self {
+        LogErrorKind::Io(e)
+    }
 }
 
 /// A log error with its context.

@@ -12,14 +12,12 @@ pub mod wildtrack;
 /// Why an import failed; every variant names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum ImportError {
-    #[error("{path}: {source}")]
-    Io {
-        path: String,
-        source: std::io::Error,
-    },
+    // `error`, not `source`: a source would be printed twice in an error chain
+    #[error("{path}: {error}")]
+    Io { path: String, error: std::io::Error },
     #[error("{path}: {reason}")]
     Parse { path: String, reason: String },
-    #[error("{0}")]
+    #[error(transparent)]
     Log(#[from] super::LogError),
 }
 
@@ -34,8 +32,8 @@ impl ImportError {
 
 /// Read a whole text file (error naming it).
 pub(crate) fn read_text(path: &std::path::Path) -> Result<String, ImportError> {
-    std::fs::read_to_string(path).map_err(|source| ImportError::Io {
+    std::fs::read_to_string(path).map_err(|error| ImportError::Io {
         path: path.display().to_string(),
-        source,
+        error,
     })
 }

@@ -75,8 +75,9 @@ impl Tree {
     fn charge(&mut self, nodes: usize) -> Result<(), String> {
         self.nodes_left = self.nodes_left.checked_sub(nodes).ok_or_else(|| {
             format!(
-                "protobuf message would take more than {} bytes as a value tree",
-                self.budget
+                "protobuf message would take more than {} bytes as a value tree ({})",
+                self.budget,
+                super::cdr::RAISE_HINT
             )
         })?;
         Ok(())

@@ -183,11 +183,12 @@ impl SessionLog {
     pub fn messages_on(&self, topics: &[&str]) -> Result<MessageStream, LogError> {
         for t in topics {
             if self.summary.channel(t).is_none() {
-                return Err(LogError::new(
-                    &self.path,
-                    LogErrorKind::MissingTopic((*t).to_string()),
-                )
-                .on_topic(t));
+                let kind = if self.summary.lost.is_empty() {
+                    LogErrorKind::MissingTopic((*t).to_string())
+                } else {
+                    missing_in_recovered(&self.summary, t)
+                };
+                return Err(LogError::new(&self.path, kind).on_topic(t));
             }
         }
         self.stream(Some(topics.iter().map(|t| (*t).to_string()).collect()))
@@ -203,5 +204,31 @@ impl SessionLog {
             topics,
             file,
         ))
+    }
+}
+
+/// A topic absent from what `--recover` could read: its channel record may be in what was
+/// lost (a log cut inside its first chunk has no channels left at all).
+fn missing_in_recovered(summary: &LogSummary, topic: &str) -> LogErrorKind {
+    let topics = summary.topics();
+    let lost: Vec<String> = summary
+        .lost
+        .iter()
+        .map(|&(a, b)| {
+            if a < b {
+                format!("bytes {a}..{b}")
+            } else {
+                format!("everything after byte {a}, never written")
+            }
+        })
+        .collect();
+    LogErrorKind::MissingTopicInRecovered {
+        topic: topic.to_string(),
+        present: if topics.is_empty() {
+            "none".to_string()
+        } else {
+            topics.join(", ")
+        },
+        lost: lost.join(", "),
     }
 }

@@ -79,6 +79,15 @@ fn werr(path: &Path, e: impl std::fmt::Display) -> LogError {
     LogError::new(path, LogErrorKind::Write(e.to_string()))
 }
 
+/// An error of the `mcap` writer: its I/O errors as themselves (the system's text, e.g. a full
+/// disk, which the `mcap` error's own text leaves out), others as text.
+fn mcap_err(path: &Path, e: mcap::McapError) -> LogError {
+    match e {
+        mcap::McapError::Io(io) => LogError::new(path, io),
+        other => werr(path, other),
+    }
+}
+
 impl SessionWriter {
     /// Start writing `path` (through `path.tmp` until [`Self::finish`]).
     pub fn create(
@@ -113,7 +122,7 @@ impl SessionWriter {
             .emit_metadata_indexes(options.summary)
             .emit_attachment_indexes(options.summary);
         let inner = mcap::Writer::with_options(BufWriter::with_capacity(1 << 20, file), opts)
-            .map_err(|e| werr(&tmp, e))?;
+            .map_err(|e| mcap_err(&tmp, e))?;
         Ok(SessionWriter {
             path,
             tmp,
@@ -149,7 +158,7 @@ impl SessionWriter {
                 let id = self
                     .writer()
                     .add_schema(type_name, "ros2msg", definition.as_bytes())
-                    .map_err(|e| werr(&self.tmp, e))?;
+                    .map_err(|e| mcap_err(&self.tmp, e))?;
                 let entry = (id, Arc::new(reg));
                 self.registries.insert(type_name.to_string(), entry.clone());
                 entry
@@ -159,7 +168,7 @@ impl SessionWriter {
         let id = self
             .writer()
             .add_channel(schema_id, topic, "cdr", &metadata)
-            .map_err(|e| werr(&self.tmp, e))?;
+            .map_err(|e| mcap_err(&self.tmp, e))?;
         self.channels.insert(
             id,
             (
@@ -188,11 +197,11 @@ impl SessionWriter {
         let schema_id = self
             .writer()
             .add_schema(schema_name, "jsonschema", json_schema.as_bytes())
-            .map_err(|e| werr(&self.tmp, e))?;
+            .map_err(|e| mcap_err(&self.tmp, e))?;
         let id = self
             .writer()
             .add_channel(schema_id, topic, "json", &BTreeMap::new())
-            .map_err(|e| werr(&self.tmp, e))?;
+            .map_err(|e| mcap_err(&self.tmp, e))?;
         self.channels
             .insert(id, (ChannelKind::Json, topic.to_string(), 0));
         Ok(ChannelId(id))
@@ -209,13 +218,13 @@ impl SessionWriter {
             Some((name, encoding, data)) => self
                 .writer()
                 .add_schema(name, encoding, data)
-                .map_err(|e| werr(&self.tmp, e))?,
+                .map_err(|e| mcap_err(&self.tmp, e))?,
             None => 0,
         };
         let id = self
             .writer()
             .add_channel(schema_id, topic, message_encoding, &BTreeMap::new())
-            .map_err(|e| werr(&self.tmp, e))?;
+            .map_err(|e| mcap_err(&self.tmp, e))?;
         self.channels
             .insert(id, (ChannelKind::Raw, topic.to_string(), 0));
         Ok(ChannelId(id))
@@ -242,7 +251,7 @@ impl SessionWriter {
         let tmp = self.tmp.clone();
         self.writer()
             .write_to_known_channel(&header, data)
-            .map_err(|e| werr(&tmp, e))
+            .map_err(|e| mcap_err(&tmp, e))
     }
 
     /// Encode a value tree as CDR on a ROS 2 channel.
@@ -314,13 +323,13 @@ impl SessionWriter {
                 name: name.to_string(),
                 metadata: entries,
             })
-            .map_err(|e| werr(&tmp, e))
+            .map_err(|e| mcap_err(&tmp, e))
     }
 
     /// Finish the file and move it to its final name.
     pub fn finish(mut self) -> Result<PathBuf, LogError> {
         let mut inner = self.inner.take().expect("finish is called once");
-        inner.finish().map_err(|e| werr(&self.tmp, e))?;
+        inner.finish().map_err(|e| mcap_err(&self.tmp, e))?;
         let buf = inner.into_inner();
         let file = buf.into_inner().map_err(|e| werr(&self.tmp, e.error()))?;
         file.sync_all().map_err(|e| LogError::new(&self.tmp, e))?;

@@ -78,12 +78,14 @@ mod tests {
                 dry_run: false,
                 shard: None,
                 aggregate_only: false,
+                expect_shards: None,
                 force: false,
                 out: dir.path().join("out"),
                 git_commit: String::new(),
                 progress: None,
                 write_tracks: None,
                 recover: false,
+                keep_going: false,
             };
             if let Err(e) = run_file(&path, &opts) {
                 let msg = format!("{e:#}");

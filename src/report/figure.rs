@@ -42,11 +42,29 @@ pub use spec::{
     Overlay, PALETTE, Panels, ScatterPlot, Sensor, Series, Significance, TopView, color,
 };
 
+/// A figure that could not be drawn (`figure NAME: reason`) or written (`writing figure NAME
+/// to PATH: reason`, the reason naming the step and its path).
 #[derive(Debug, thiserror::Error)]
-#[error("figure {name}: {reason}")]
+#[error("{}", match path {
+    Some(p) => format!("writing figure {name} to {}: {reason}", p.display()),
+    None => format!("figure {name}: {reason}"),
+})]
 pub struct FigureError {
     pub name: String,
     pub reason: String,
+    /// The file being written, for an I/O error.
+    pub path: Option<std::path::PathBuf>,
+}
+
+impl FigureError {
+    /// An I/O error writing figure `name` to `path`.
+    pub fn io(name: &str, path: &std::path::Path, e: &std::io::Error) -> FigureError {
+        FigureError {
+            name: name.to_string(),
+            reason: e.to_string(),
+            path: Some(path.to_path_buf()),
+        }
+    }
 }
 
 impl Figure {
@@ -54,6 +72,7 @@ impl Figure {
         FigureError {
             name: self.name.clone(),
             reason: e.to_string(),
+            path: None,
         }
     }
 

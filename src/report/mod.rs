@@ -19,13 +19,11 @@ pub fn write_figure(
     fig: &Figure,
     root: &Path,
 ) -> Result<Vec<PathBuf>, figure::FigureError> {
-    let io = |e: std::io::Error| figure::FigureError {
-        name: fig.name.clone(),
-        reason: e.to_string(),
-    };
     let png = dir.join(format!("{}.png", fig.name));
-    atomic::write_atomic(&png, &fig.to_png()?, Some(root)).map_err(io)?;
+    atomic::write_atomic(&png, &fig.to_png()?, Some(root))
+        .map_err(|e| figure::FigureError::io(&fig.name, &png, &e))?;
     let svg = dir.join(format!("{}.svg", fig.name));
-    atomic::write_atomic(&svg, fig.to_svg()?.as_bytes(), Some(root)).map_err(io)?;
+    atomic::write_atomic(&svg, fig.to_svg()?.as_bytes(), Some(root))
+        .map_err(|e| figure::FigureError::io(&fig.name, &svg, &e))?;
     Ok(vec![png, svg])
 }

@@ -28,10 +28,7 @@ pub fn path(root: &Path, name: &str) -> PathBuf {
 pub fn write(root: &Path, name: &str, p: &PreviewData) -> Result<PathBuf, FigureError> {
     let path = path(root, name);
     let png = sheet(name, p)?;
-    atomic::write_atomic(&path, &png, Some(root)).map_err(|e| FigureError {
-        name: name.into(),
-        reason: e.to_string(),
-    })?;
+    atomic::write_atomic(&path, &png, Some(root)).map_err(|e| FigureError::io(name, &path, &e))?;
     Ok(path)
 }
 
@@ -181,6 +178,7 @@ pub fn sheet(name: &str, p: &PreviewData) -> Result<Vec<u8>, FigureError> {
         .map_err(|e| FigureError {
             name: name.into(),
             reason: e.to_string(),
+            path: None,
         })?;
     Ok(out)
 }

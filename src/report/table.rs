@@ -45,15 +45,16 @@ pub struct Table {
     pub samples: Option<DataFrame>,
 }
 
+// `error`, not `source`: a source would be printed twice in an error chain
 #[derive(Debug, thiserror::Error)]
 pub enum TableError {
-    #[error("table {table}: {source}")]
-    Polars { table: String, source: PolarsError },
-    #[error("table {table}: cannot write {path}: {source}")]
+    #[error("table {table}: {error}")]
+    Polars { table: String, error: PolarsError },
+    #[error("writing table {table} to {}: {error}", path.display())]
     Io {
         table: String,
         path: PathBuf,
-        source: std::io::Error,
+        error: std::io::Error,
     },
 }
 
@@ -93,7 +94,7 @@ impl Table {
     fn err(&self, source: PolarsError) -> TableError {
         TableError::Polars {
             table: self.name.clone(),
-            source,
+            error: source,
         }
     }
 
@@ -304,10 +305,10 @@ pub fn write_table(dir: &Path, table: &Table, root: &Path) -> Result<Vec<PathBuf
     let mut written = Vec::new();
     let mut put = |ext: &str, bytes: Vec<u8>| -> Result<(), TableError> {
         let path = dir.join(format!("{}.{ext}", table.name));
-        write_atomic(&path, &bytes, Some(root)).map_err(|source| TableError::Io {
+        write_atomic(&path, &bytes, Some(root)).map_err(|error| TableError::Io {
             table: table.name.clone(),
             path: path.clone(),
-            source,
+            error,
         })?;
         written.push(path);
         Ok(())

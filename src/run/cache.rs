@@ -1,7 +1,8 @@
 //! The per-session Parquet cache: `out/<pipeline>/sessions/<dataset>/<session>/` holds one
 //! `<table>.parquet` per table, `source.txt` (the log's hash and path) and `key.txt`, written
 //! last. The key hashes the log's bytes, the experiment's kind and `VERSION`, the tool version,
-//! the parameters and the topic remaps: a result is reused only when all of them match.
+//! the parameters and the topic remaps (and `--recover` and a structure limit set by
+//! `--max-structure-mib`, when given): a result is reused only when all of them match.
 //!
 //! `--aggregate-only` needs no logs: a session whose log is absent is found through the path
 //! recorded in its `source.txt`, and its key is recomputed from the recorded hash.
@@ -14,6 +15,9 @@ use xxhash_rust::xxh3::Xxh3;
 use super::SessionTables;
 use super::config::SessionRef;
 use crate::report::table::{parquet_bytes, read_parquet};
+use anyhow::Context;
+
+use crate::report::atomic::{at, io_error};
 use crate::report::{Provenance, atomic};
 
 const KEY_FILE: &str = "key.txt";
@@ -59,6 +63,12 @@ impl KeyParts<'_> {
         if self.recover {
             h.update(b"recover");
         }
+        // a raised (or lowered) structure budget can let a message decode that the default
+        // refuses: such results are cached apart; the default leaves keys as they were
+        if let Some(limit) = crate::log::cdr::structure_limit() {
+            h.update(b"structure-limit");
+            h.update(&(limit as u64).to_le_bytes());
+        }
         format!("{:032x}", h.digest128())
     }
 }
@@ -90,7 +100,9 @@ pub fn load(dir: &Path, key: &str) -> Option<(SessionTables, Vec<String>)> {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
         Err(_) => return None,
     };
-    Some((tables, warnings))
+    // another run may have replaced the folder while it was read: then compute it again
+    let after = std::fs::read_to_string(dir.join(KEY_FILE)).ok()?;
+    (after == stored).then_some((tables, warnings))
 }
 
 /// The log hash recorded with a cached result (none for caches without `source.txt`).
@@ -99,7 +111,14 @@ pub fn recorded_hash(dir: &Path) -> Option<u128> {
     u128::from_str_radix(text.lines().next()?.trim(), 16).ok()
 }
 
-/// Write a session's tables: into a scratch folder first, key last, then swap it into place.
+/// Write a session's tables: into a folder staged in this run's scratch folder first, key
+/// last, then moved into place by one rename, so a cached result is complete or absent.
+/// Errors name the path and the step.
+///
+/// Another run may store the same session at the same time (two runs into one folder, or
+/// shards that overlap): an old result in the way is moved aside (a rename) and the new one
+/// renamed in; when the result in place already has this key, another run stored this same
+/// result (same inputs, same key, same bytes) and it is kept.
 pub fn store(
     out: &Path,
     dir: &Path,
@@ -108,40 +127,88 @@ pub fn store(
     (tables, warnings): (&SessionTables, &[String]),
     prov: &Provenance,
 ) -> anyhow::Result<()> {
+    let scratch = atomic::scratch_dir(out)?;
     let tag = xxhash_rust::xxh3::xxh3_64(dir.to_string_lossy().as_bytes());
-    let scratch = out
-        .join(atomic::SCRATCH_DIR)
-        .join(format!("session-{}-{tag:016x}", std::process::id()));
-    if scratch.exists() {
-        std::fs::remove_dir_all(&scratch)?;
+    let staged = scratch.join(format!("session-{tag:016x}"));
+    if staged.exists() {
+        std::fs::remove_dir_all(&staged).map_err(at("removing", &staged))?;
     }
-    std::fs::create_dir_all(&scratch)?;
+    std::fs::create_dir_all(&staged).map_err(at("creating folder", &staged))?;
+    let write = |name: &str, bytes: &[u8]| {
+        let p = staged.join(name);
+        std::fs::write(&p, bytes).map_err(at("writing", &p))
+    };
     for (name, df) in tables {
-        std::fs::write(
-            scratch.join(format!("{name}.parquet")),
-            parquet_bytes(df, prov)?,
-        )?;
+        let bytes = parquet_bytes(df, prov)
+            .with_context(|| format!("table {name} of {}", dir.display()))?;
+        write(&format!("{name}.parquet"), &bytes)?;
     }
     let (path, hash) = source;
-    std::fs::write(
-        scratch.join(SOURCE_FILE),
-        format!("{hash:032x}\n{}\n", path.display()),
+    write(
+        SOURCE_FILE,
+        format!("{hash:032x}\n{}\n", path.display()).as_bytes(),
     )?;
     if !warnings.is_empty() {
         // one line each: a warning never holds a newline (they are one-line messages)
         let lines: Vec<String> = warnings.iter().map(|w| w.replace('\n', " ")).collect();
-        std::fs::write(scratch.join(WARNINGS_FILE), lines.join("\n") + "\n")?;
+        write(WARNINGS_FILE, (lines.join("\n") + "\n").as_bytes())?;
     }
-    std::fs::write(scratch.join(KEY_FILE), key)?;
-    if dir.exists() {
-        std::fs::remove_dir_all(dir)?;
+    write(KEY_FILE, key.as_bytes())?;
+    if let Some(parent) = dir.parent() {
+        std::fs::create_dir_all(parent).map_err(at("creating folder", parent))?;
     }
     atomic::maybe_abort_hook();
-    if let Some(parent) = dir.parent() {
-        std::fs::create_dir_all(parent)?;
+    install(
+        &staged,
+        dir,
+        key,
+        &scratch.join(format!("replaced-{tag:016x}")),
+    )
+}
+
+/// Move the staged folder to `dir`, moving a result in the way aside (to `aside`, then
+/// removed), or keeping it when it is this same result stored by another run.
+fn install(staged: &Path, dir: &Path, key: &str, aside: &Path) -> anyhow::Result<()> {
+    const TRIES: usize = 8;
+    for attempt in 0..TRIES {
+        let aside = aside.with_extension(attempt.to_string());
+        match std::fs::rename(staged, dir) {
+            Ok(()) => return Ok(()),
+            Err(_) if dir.is_dir() => {
+                let in_place = std::fs::read_to_string(dir.join(KEY_FILE)).ok();
+                if in_place.as_deref().map(str::trim) == Some(key) {
+                    let _ = std::fs::remove_dir_all(staged);
+                    return Ok(());
+                }
+                match std::fs::rename(dir, &aside) {
+                    Ok(()) => {
+                        let _ = std::fs::remove_dir_all(&aside);
+                    }
+                    // another run moved it first
+                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                    Err(e) => {
+                        let what = format!(
+                            "moving the earlier cached result {} aside to",
+                            dir.display()
+                        );
+                        return Err(io_error(&what, &aside, &e).into());
+                    }
+                }
+            }
+            Err(e) => {
+                return Err(io_error(
+                    &format!("moving {} into place at", staged.display()),
+                    dir,
+                    &e,
+                )
+                .into());
+            }
+        }
     }
-    std::fs::rename(&scratch, dir)?;
-    Ok(())
+    anyhow::bail!(
+        "{}: other runs kept replacing this cached result ({TRIES} tries)",
+        dir.display()
+    )
 }
 
 /// Sessions with a cached result under `out/<pipeline>/sessions/` whose recorded log path

@@ -30,10 +30,11 @@ use serde::{Deserialize, Serialize};
 
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
-    #[error("cannot read pipeline file {path}: {source}")]
+    // `error`, not `source`: a source would be printed twice in an error chain
+    #[error("cannot read pipeline file {path}: {error}")]
     Read {
         path: PathBuf,
-        source: std::io::Error,
+        error: std::io::Error,
     },
     #[error("{path}: {message}")]
     Parse { path: PathBuf, message: String },
@@ -55,6 +56,13 @@ pub enum ConfigError {
     },
     #[error("bad session glob `{pattern}`: {reason}")]
     Glob { pattern: String, reason: String },
+    /// A folder a session glob walks cannot be read: its sessions would be missing unsaid.
+    #[error("session glob `{pattern}`: cannot read folder {}: {error}", folder.display())]
+    GlobFolder {
+        pattern: String,
+        folder: PathBuf,
+        error: std::io::Error,
+    },
 }
 
 /// `[pipeline]`.
@@ -101,9 +109,9 @@ struct KindSection {
 
 /// Read a pipeline file and return its text and `pipeline.kind`.
 pub fn read_kind(path: &Path) -> Result<(String, String), ConfigError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+    let text = std::fs::read_to_string(path).map_err(|error| ConfigError::Read {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     let kind = kind_of(path, &text)?;
     Ok((text, kind))
@@ -282,7 +290,8 @@ fn dataset_name(file: &std::path::Path) -> String {
     }
 }
 
-/// Expand globs (sorted, without repeats), drop excluded names, name each session.
+/// Expand globs (sorted, without repeats), drop excluded names, name each session. A folder
+/// on a glob's way that cannot be read is an error naming it (its sessions would be missing).
 pub fn find_sessions(
     patterns: &[String],
     exclude: &[String],
@@ -302,7 +311,12 @@ pub fn find_sessions(
             pattern: pattern.clone(),
             reason: e.to_string(),
         })?;
-        for p in paths.flatten() {
+        for p in paths {
+            let p = p.map_err(|e| ConfigError::GlobFolder {
+                pattern: pattern.clone(),
+                folder: e.path().to_path_buf(),
+                error: e.into(),
+            })?;
             if !p.is_file() {
                 continue;
             }

@@ -16,10 +16,20 @@
 //! `process`) is skipped, counted and listed with its reason in the run summary, in the
 //! pipeline's `skipped_sessions` table ([`skipped`], written by the runner for every pipeline)
 //! and in the report — never silently dropped; the other sessions' results are kept. The cache lives in `cache`
-//! (`--aggregate-only` reads it without the logs).
+//! (`--aggregate-only` reads it without the logs). A session computed but whose results could
+//! not be stored in the cache keeps its results in this run's tables, is listed (`unstored`,
+//! with the cache path and the reason) and fails the run unless `--keep-going`.
+//!
+//! Runs that share an output folder: a run that writes a pipeline's products (a full run or
+//! `--aggregate-only`) holds `out/<pipeline>/.lock` ([`lock`]) from its plan to its end, so a
+//! second one fails at once naming the folder and the holder's process id; shards only store
+//! sessions (complete or absent, by rename) and take no lock; every process writes its scratch
+//! files in its own folder ([`crate::report::atomic`]).
 
 mod cache;
 pub mod config;
+mod inputs;
+pub mod lock;
 pub mod report;
 pub mod shard;
 pub mod skipped;
@@ -110,6 +120,13 @@ pub trait Experiment: Sync {
         Vec::new()
     }
 
+    /// Files the parameters name that must exist before anything runs (e.g. a model to
+    /// load): `(key path within [params], path)`. A missing one is an error naming the
+    /// pipeline file, the key's line and the path, in `--dry-run` too.
+    fn required_files(_params: &Self::Params) -> Vec<(String, PathBuf)> {
+        Vec::new()
+    }
+
     /// Process one session into named tables.
     fn process(
         session: &Session,
@@ -132,6 +149,9 @@ pub struct RunOptions {
     pub shard: Option<(usize, usize)>,
     /// Aggregate cached session results only (after sharded runs).
     pub aggregate_only: bool,
+    /// With `aggregate_only`: the number of shards whose records must all be there
+    /// (`--expect-shards N`); their skipped sessions are reported with their reasons.
+    pub expect_shards: Option<usize>,
     /// Recompute even when a cached result matches.
     pub force: bool,
     pub out: PathBuf,
@@ -144,6 +164,9 @@ pub struct RunOptions {
     /// Read damaged logs as far as they go (`--recover`): every complete chunk before the
     /// damage (and good chunks after it); what was lost is listed per session.
     pub recover: bool,
+    /// `--keep-going`: a session computed but whose results could not be stored in the cache
+    /// does not fail the run (it is still listed, `unstored`).
+    pub keep_going: bool,
 }
 
 /// What a run did, for the report.
@@ -171,6 +194,9 @@ pub struct RunSummary {
     pub seconds: f64,
     /// Dry-run plan text (empty for real runs).
     pub plan: String,
+    /// Warnings about the run as a whole (a `[topics]` remap no session has, a folder that
+    /// could not be locked), each naming the file or folder.
+    pub notices: Vec<String>,
 }
 
 /// Check that a session has every required topic.
@@ -190,6 +216,7 @@ fn plan_text<E: Experiment>(
     file: &PipelineFile<E::Params>,
     sessions: &[SessionRef],
     stages: &[Stage],
+    notices: &[String],
 ) -> String {
     use std::fmt::Write;
     let mut o = String::new();
@@ -250,6 +277,9 @@ fn plan_text<E: Experiment>(
             s.path.display()
         );
     }
+    for n in notices {
+        let _ = writeln!(o, "warning: {n}");
+    }
     o
 }
 
@@ -281,6 +311,7 @@ fn plan<E: Experiment>(
     opts: &RunOptions,
 ) -> anyhow::Result<Plan<E::Params>> {
     let (file, stages) = check_experiment::<E>(path, text)?;
+    inputs::check_required(path, text, &E::required_files(&file.params))?;
     let patterns = opts
         .sessions
         .clone()
@@ -305,12 +336,7 @@ fn plan<E: Experiment>(
         sessions.sort();
     }
     if let Some((k, n)) = opts.shard {
-        sessions = sessions
-            .into_iter()
-            .enumerate()
-            .filter(|(i, _)| i % n == k - 1)
-            .map(|(_, s)| s)
-            .collect();
+        sessions = shard::of_shard(sessions, k, n);
     }
     Ok(Plan {
         file,
@@ -353,6 +379,8 @@ struct SessionResult {
     tables: SessionTables,
     cached: bool,
     warnings: Vec<String>,
+    /// Why its results, computed, could not be stored in the cache (naming the path).
+    not_stored: Option<String>,
 }
 
 /// Step 2, one session: its cached tables when the key matches, else `process` (then cached).
@@ -378,6 +406,7 @@ fn session_tables<E: Experiment>(
             tables,
             cached: true,
             warnings,
+            not_stored: None,
         });
     }
     if opts.aggregate_only {
@@ -397,18 +426,21 @@ fn session_tables<E: Experiment>(
         result => (result?, log),
     };
     let warnings = log.summary().warnings.clone();
-    cache::store(
+    let not_stored = cache::store(
         &opts.out,
         &dir,
         &key,
         (&s.path, file_hash),
         (&tables, &warnings),
         job.provenance,
-    )?;
+    )
+    .err()
+    .map(|e| format!("{}{}: {e:#}", skipped::NOT_STORED, dir.display()));
     Ok(SessionResult {
         tables,
         cached: false,
         warnings,
+        not_stored,
     })
 }
 
@@ -525,6 +557,45 @@ fn write_products(
     Ok(())
 }
 
+/// What step 2 gave, sorted for the later steps.
+#[derive(Default)]
+struct Collected {
+    /// Sessions with results.
+    done: Vec<(SessionRef, SessionTables)>,
+    /// Sessions without results, and why.
+    not_done: Vec<(SessionRef, String)>,
+    /// Sessions with results and a warning: read with warnings, or not stored in the cache.
+    warned: Vec<(SessionRef, String)>,
+}
+
+/// Sort the sessions' outcomes into results, skips and warnings, counted in `summary`.
+fn collect(outcomes: Vec<Outcome>, summary: &mut RunSummary) -> Collected {
+    let mut c = Collected::default();
+    let label = |s: &SessionRef| format!("{}/{}", s.dataset, s.name);
+    for outcome in outcomes {
+        match outcome {
+            Ok((s, result)) => {
+                if result.cached {
+                    summary.cached += 1;
+                } else {
+                    summary.computed += 1;
+                }
+                let warnings = (!result.warnings.is_empty()).then(|| result.warnings.join("; "));
+                for why in warnings.into_iter().chain(result.not_stored) {
+                    summary.warned.push((label(&s), why.clone()));
+                    c.warned.push((s.clone(), why));
+                }
+                c.done.push((s, result.tables));
+            }
+            Err((s, reason)) => {
+                summary.skipped.push((label(&s), reason.clone()));
+                c.not_done.push((s, reason));
+            }
+        }
+    }
+    c
+}
+
 /// Run one pipeline file end to end with experiment `E`: plan, per-session processing
 /// (cached), aggregation, and writing of its products.
 pub fn run_experiment<E: Experiment>(
@@ -533,7 +604,17 @@ pub fn run_experiment<E: Experiment>(
     opts: &RunOptions,
 ) -> anyhow::Result<RunSummary> {
     let started = Instant::now();
-    let plan = plan::<E>(path, text, opts)?;
+    let mut plan = plan::<E>(path, text, opts)?;
+    let params_json = serde_json::to_string(&plan.file.params)?;
+    let topics_json = serde_json::to_string(&plan.file.topics)?;
+    let config = shard::config_hash(E::KIND, E::VERSION, &params_json, &topics_json);
+    let pipeline_dir = opts.out.join(&plan.file.pipeline.name);
+    let recorded = match opts.expect_shards {
+        Some(n) if opts.aggregate_only => {
+            shard::expect(&pipeline_dir, n, &config, &mut plan.sessions)?
+        }
+        _ => Vec::new(),
+    };
     let file = &plan.file;
     let name = file.pipeline.name.clone();
     let mut summary = RunSummary {
@@ -552,16 +633,30 @@ pub fn run_experiment<E: Experiment>(
         artifacts: Vec::new(),
         seconds: 0.0,
         plan: String::new(),
+        notices: Vec::new(),
     };
-    if opts.dry_run {
-        summary.plan = plan_text::<E>(file, &plan.sessions, &plan.stages);
-        return Ok(summary);
-    }
     if plan.sessions.is_empty() {
         anyhow::bail!("{}: no sessions match {:?}", path.display(), plan.patterns);
     }
-    let params_json = serde_json::to_string(&file.params)?;
-    let topics_json = serde_json::to_string(&file.topics)?;
+    // a run that writes the pipeline's products holds its folder from here to its end
+    let held = if opts.dry_run || opts.shard.is_some() {
+        None
+    } else {
+        Some(lock::FolderLock::acquire(&opts.out.join(&name))?)
+    };
+    summary
+        .notices
+        .extend(held.as_ref().and_then(|l| l.unsupported.clone()));
+    summary.notices.extend(inputs::absent_topics(
+        path,
+        text,
+        &file.topics,
+        &plan.sessions,
+    ));
+    if opts.dry_run {
+        summary.plan = plan_text::<E>(file, &plan.sessions, &plan.stages, &summary.notices);
+        return Ok(summary);
+    }
     let provenance = provenance(&plan.sessions, &opts.git_commit, &params_json);
     let job = SessionJob {
         plan: &plan,
@@ -577,39 +672,23 @@ pub fn run_experiment<E: Experiment>(
         provenance: &provenance,
         bars: reporter(&opts.progress),
     };
-    let mut done = Vec::new();
-    let mut not_done = Vec::new();
-    let mut warned = Vec::new();
-    for outcome in process_sessions::<E>(&job) {
-        match outcome {
-            Ok((s, result)) => {
-                if result.cached {
-                    summary.cached += 1;
-                } else {
-                    summary.computed += 1;
-                }
-                if !result.warnings.is_empty() {
-                    let why = result.warnings.join("; ");
-                    summary
-                        .warned
-                        .push((format!("{}/{}", s.dataset, s.name), why.clone()));
-                    warned.push((s.clone(), why));
-                }
-                done.push((s, result.tables));
-            }
-            Err((s, reason)) => {
-                summary
-                    .skipped
-                    .push((format!("{}/{}", s.dataset, s.name), reason.clone()));
-                not_done.push((s, reason));
-            }
-        }
-    }
-    if opts.shard.is_some() {
+    let mut c = collect(process_sessions::<E>(&job), &mut summary);
+    shard::use_recorded_reasons(&recorded, &mut c.not_done, &mut summary.skipped);
+    if let Some(k_of_n) = opts.shard {
         summary.seconds = started.elapsed().as_secs_f64();
+        skipped::fail_if_unstored(&summary, opts)?;
+        let (sessions, not_done) = (&plan.sessions, &c.not_done);
+        shard::write_record(
+            &opts.out,
+            &pipeline_dir,
+            k_of_n,
+            &config,
+            sessions,
+            not_done,
+        )?;
         return Ok(summary);
     }
-    if done.is_empty() {
+    if c.done.is_empty() {
         anyhow::bail!(
             "{}: every session was skipped; first: {}",
             path.display(),
@@ -622,21 +701,23 @@ pub fn run_experiment<E: Experiment>(
     // step 3: aggregate
     let products = E::aggregate(
         &Aggregate {
-            sessions: &done,
+            sessions: &c.done,
             provenance: provenance.clone(),
             write_tracks: opts.write_tracks.as_deref(),
         },
         &file.params,
     )?;
-    write_products(products, &opts.out, &provenance, &mut summary)?;
-    let skipped_table = skipped::table(&not_done, &warned, &provenance)?;
-    write_table(
-        &opts.out.join(&name).join("tables"),
-        &skipped_table,
-        &opts.out,
-    )?;
+    let skipped_table = skipped::table(&c.not_done, &c.warned, &provenance)?;
+    write_products(products, &opts.out, &provenance, &mut summary)
+        .and_then(|()| {
+            let tables = opts.out.join(&name).join("tables");
+            Ok(write_table(&tables, &skipped_table, &opts.out).map(|_| ())?)
+        })
+        .map_err(|e| skipped::also_unstored(e, &summary))?;
     summary.skipped_table = format!("{name}/tables/{}.md", skipped::TABLE);
     summary.seconds = started.elapsed().as_secs_f64();
+    skipped::fail_if_unstored(&summary, opts)?;
+    drop(held);
     Ok(summary)
 }
 

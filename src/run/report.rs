@@ -60,7 +60,10 @@ pub fn render(runs: &[RunSummary], tables_md: &BTreeMap<String, String>, h: &Hea
         for line in &r.summary {
             let _ = writeln!(o, "- {line}");
         }
-        if !r.summary.is_empty() {
+        for n in &r.notices {
+            let _ = writeln!(o, "- **Warning**: {n}");
+        }
+        if !r.summary.is_empty() || !r.notices.is_empty() {
             o.push('\n');
         }
         for (title, path) in &r.tables {
@@ -92,11 +95,12 @@ pub fn render(runs: &[RunSummary], tables_md: &BTreeMap<String, String>, h: &Hea
             if !r.warned.is_empty() {
                 let _ = writeln!(
                     o,
-                    "\nRead with warnings ({}; their results are kept):\n",
+                    "\nKept with warnings ({}; their results are in the tables):\n",
                     r.warned.len()
                 );
                 for (s, why) in &r.warned {
-                    let _ = writeln!(o, "- `{s}` ({}): {why}", super::skipped::WARNED);
+                    let status = super::skipped::warned_status(why);
+                    let _ = writeln!(o, "- `{s}` ({status}): {why}");
                 }
             }
             if !r.skipped_table.is_empty() {
@@ -157,6 +161,7 @@ mod tests {
             artifacts: Vec::new(),
             seconds: 1.25,
             plan: String::new(),
+            notices: Vec::new(),
         };
         let md = BTreeMap::from([(
             "dataset_quality/tables/sessions.md".to_string(),

@@ -15,7 +15,11 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use anyhow::Context;
+use xxhash_rust::xxh3::Xxh3;
+
 use super::config::SessionRef;
+use crate::report::atomic::write_atomic;
 
 /// Keep the sessions of shard `k` of `n` (1-based): index `i` of the order by
 /// `(hash, dataset, name)` belongs to shard `i mod n + 1`. `hash` is the log's content hash.
@@ -45,6 +49,8 @@ pub fn assign<E>(
 pub struct RecordedSession {
     pub dataset: String,
     pub name: String,
+    /// The log it was read from (the aggregate may run with the logs gone).
+    pub path: PathBuf,
     /// Why it has no result (`None`: its result is in the cache).
     pub skipped: Option<String>,
 }
@@ -108,6 +114,126 @@ pub fn check_records(pipeline_dir: &Path, n: usize, config: &str) -> (Vec<Record
         }
     }
     (records, problems)
+}
+
+/// The sessions of shard `k` of `n` among `sessions`, by the hash of each log's bytes. A log
+/// that cannot be read hashes as 0 here: it still belongs to exactly one shard, whose run
+/// reports it skipped with the read error.
+pub fn of_shard(sessions: Vec<SessionRef>, k: usize, n: usize) -> Vec<SessionRef> {
+    let hashed = assign(sessions, (k, n), |s| {
+        Ok::<_, std::convert::Infallible>(super::cache::hash_file(&s.path).unwrap_or(0))
+    });
+    match hashed {
+        Ok(v) => v,
+        Err(never) => match never {},
+    }
+}
+
+/// What a record's configuration hash covers: the experiment, its version and its parameters
+/// and topic remaps (the parts of the cache key that are not the log).
+pub fn config_hash(kind: &str, version: u32, params_json: &str, topics_json: &str) -> String {
+    let mut h = Xxh3::new();
+    for part in [
+        kind.as_bytes(),
+        &version.to_le_bytes(),
+        params_json.as_bytes(),
+    ] {
+        h.update(&(part.len() as u64).to_le_bytes());
+        h.update(part);
+    }
+    h.update(topics_json.as_bytes());
+    format!("{:032x}", h.digest128())
+}
+
+/// Write shard `k/n`'s record: its sessions and, for those without a result, why.
+pub fn write_record(
+    out: &Path,
+    pipeline_dir: &Path,
+    (k, n): (usize, usize),
+    config: &str,
+    sessions: &[SessionRef],
+    not_done: &[(SessionRef, String)],
+) -> anyhow::Result<()> {
+    let record = Record {
+        shard: k,
+        of: n,
+        config: config.to_string(),
+        sessions: sessions
+            .iter()
+            .map(|s| RecordedSession {
+                dataset: s.dataset.clone(),
+                name: s.name.clone(),
+                path: s.path.clone(),
+                skipped: not_done
+                    .iter()
+                    .find(|(d, _)| d == s)
+                    .map(|(_, why)| why.clone()),
+            })
+            .collect(),
+    };
+    let path = record_path(pipeline_dir, k, n);
+    let json = serde_json::to_string_pretty(&record)?;
+    write_atomic(&path, json.as_bytes(), Some(out))
+        .with_context(|| format!("writing shard {k}/{n}'s record {}", path.display()))
+}
+
+/// `--expect-shards n`: every shard's record must count, else an error naming each shard that
+/// does not; the recorded sessions join `sessions` (their logs may be gone) and the reasons
+/// of those recorded as skipped are returned, keyed by `(dataset, name)`.
+pub fn expect(
+    pipeline_dir: &Path,
+    n: usize,
+    config: &str,
+    sessions: &mut Vec<SessionRef>,
+) -> anyhow::Result<Vec<((String, String), String)>> {
+    let (records, problems) = check_records(pipeline_dir, n, config);
+    if !problems.is_empty() {
+        anyhow::bail!(
+            "{} of {n} shards do not count, so nothing was aggregated:\n  {}\n\
+             rerun those shards (sessions already cached are not recomputed), then aggregate again",
+            problems.len(),
+            problems.join("\n  ")
+        );
+    }
+    let mut reasons = Vec::new();
+    for r in records.into_iter().flat_map(|r| r.sessions) {
+        if !sessions
+            .iter()
+            .any(|s| s.dataset == r.dataset && s.name == r.name)
+        {
+            sessions.push(SessionRef {
+                dataset: r.dataset.clone(),
+                name: r.name.clone(),
+                path: r.path.clone(),
+            });
+        }
+        if let Some(why) = r.skipped {
+            reasons.push(((r.dataset, r.name), why));
+        }
+    }
+    sessions.sort();
+    Ok(reasons)
+}
+
+/// Give sessions skipped for want of a cached result the reason their shard recorded.
+pub fn use_recorded_reasons(
+    reasons: &[((String, String), String)],
+    not_done: &mut [(SessionRef, String)],
+    skipped: &mut [(String, String)],
+) {
+    for ((dataset, name), why) in reasons {
+        let label = format!("{dataset}/{name}");
+        for (s, r) in not_done.iter_mut() {
+            if &s.dataset == dataset && &s.name == name && r == super::skipped::NOT_CACHED {
+                r.clone_from(why);
+            }
+        }
+        for (l, r) in skipped.iter_mut() {
+            if *l == label && r == super::skipped::NOT_CACHED {
+                r.clone_from(why);
+            }
+        }
+    }
 }
 
 #[cfg(test)]

@@ -17,10 +17,11 @@ pub use follow::{Controller, Estimator, Follow};
 
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {
-    #[error("cannot read scenario {path}: {source}")]
+    // `error`, not `source`: a source would be printed twice in an error chain
+    #[error("cannot read scenario {path}: {error}")]
     Read {
         path: PathBuf,
-        source: std::io::Error,
+        error: std::io::Error,
     },
     #[error("{path}: {message}")]
     Parse { path: PathBuf, message: String },
@@ -565,9 +566,9 @@ pub struct Scenario {
 impl Scenario {
     /// Read, parse and validate a scenario, applying `profile` (`quick`, `full`, ...).
     pub fn load(path: &Path, profile: &str) -> Result<(Scenario, String), ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Read {
+        let text = std::fs::read_to_string(path).map_err(|error| ScenarioError::Read {
             path: path.to_path_buf(),
-            source,
+            error,
         })?;
         let mut s: Scenario = toml::from_str(&text).map_err(|e| ScenarioError::Parse {
             path: path.to_path_buf(),

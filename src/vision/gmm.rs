@@ -152,8 +152,15 @@ pub enum GmmError {
     },
     #[error("saved model state is invalid: {what}")]
     BadState { what: String },
+    // no `#[from]`: a source would be printed twice in an error chain (`From` is below)
     #[error("saved model state: {0}")]
-    Io(#[from] std::io::Error),
+    Io(std::io::Error),
+}
+
+impl From<std::io::Error> for GmmError {
+    fn from(e: std::io::Error) -> Self {
+        GmmError::Io(e)
+    }
 }
 
 /// When eq. 14 drops a component that the data no longer support.

@@ -102,12 +102,13 @@ pub enum LocalError {
         have_width: usize,
         have_height: usize,
     },
+    // no `#[from]`: a source would be printed twice in an error chain (`From`s are below)
     #[error("background model: {0}")]
-    Gmm(#[from] GmmError),
+    Gmm(GmmError),
     #[error("blobs: {0}")]
-    Blobs(#[from] BlobError),
+    Blobs(BlobError),
     #[error("colour tracker: {0}")]
-    Colour(#[from] ColorTrackError),
+    Colour(ColorTrackError),
     #[error("parameter `{name}` = {value} {why}")]
     BadParam {
         name: &'static str,
@@ -115,6 +116,17 @@ pub enum LocalError {
         why: &'static str,
     },
 }
+
+macro_rules! from_errors {
+    ($($t:ty => $v:ident),*) => {
+        $(impl From<$t> for LocalError {
+            fn from(e: $t) -> Self {
+                LocalError::$v(e)
+            }
+        })*
+    };
+}
+from_errors!(GmmError => Gmm, BlobError => Blobs, ColorTrackError => Colour);
 
 /// Parameters; [`Default`] gives the values in `pipelines/s003_zivkovic_background.toml`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -293,16 +293,16 @@ pub fn read(dir: &Path, intr: Intrinsics) -> Result<Dataset, ImportError> {
         .map(|c| read_camera(dir, c, intr))
         .collect::<Result<Vec<_>, _>>()?;
     let adir = dir.join("annotations_positions");
-    let entries = std::fs::read_dir(&adir).map_err(|source| ImportError::Io {
+    let entries = std::fs::read_dir(&adir).map_err(|error| ImportError::Io {
         path: adir.display().to_string(),
-        source,
+        error,
     })?;
     let mut files: Vec<(u32, PathBuf)> = Vec::new();
     for e in entries {
         let path = e
-            .map_err(|source| ImportError::Io {
+            .map_err(|error| ImportError::Io {
                 path: adir.display().to_string(),
-                source,
+                error,
             })?
             .path();
         if path.extension().is_none_or(|x| x != "json") {

@@ -40,6 +40,9 @@ pub struct LogSummary {
     pub file_len: u64,
     /// Where the file's own index disagreed with its data (and the data was believed).
     pub warnings: Vec<String>,
+    /// Read with `--recover`: the byte ranges `[start, end)` left out (a cut tail, chunks that
+    /// do not open); an empty range where the file ends right after a complete record.
+    pub lost: Vec<(u64, u64)>,
 }
 
 impl LogSummary {
@@ -485,10 +488,19 @@ impl LinearIndex {
         }
         // the error names the last complete message
         let file_len = self.summary.file_len;
-        self.summary.warnings.push(format!(
-            "recovered: {e}; bytes {at}..{file_len} ({} bytes) are lost",
-            file_len - at
-        ));
+        let lost = if at < file_len {
+            format!("bytes {at}..{file_len} ({} bytes) are lost", file_len - at)
+        } else {
+            // cut on a record boundary: no partial record, only what was never written
+            format!(
+                "the file ends at byte {at}, after a complete record: no partial record is lost, \
+                 but nothing after it (more records, the summary section) was written"
+            )
+        };
+        self.summary
+            .warnings
+            .push(format!("recovered: {e}; {lost}"));
+        self.summary.lost.push((at, file_len));
         self.summary.file_len = at;
         Ok(self.finish())
     }
@@ -499,9 +511,10 @@ impl LinearIndex {
             Ok(h) => format!(", declared {}..{} s", Nanos(h.start), Nanos(h.end)),
             Err(_) => String::new(),
         };
+        let total = len + RECORD_HEAD_LEN as u64;
         self.summary.warnings.push(format!(
-            "recovered: the chunk at byte {pos} ({} bytes{span}) is skipped: {e}",
-            len + RECORD_HEAD_LEN as u64
+            "recovered: the chunk at byte {pos} ({total} bytes{span}) is skipped: {e}"
         ));
+        self.summary.lost.push((pos, pos + total));
     }
 }

@@ -69,6 +69,15 @@ impl Experiment for OmniAppearance {
         params::validate(p)
     }
 
+    /// The model to load (`model`), checked before anything runs.
+    fn required_files(p: &Params) -> Vec<(String, std::path::PathBuf)> {
+        if p.model.is_empty() {
+            Vec::new()
+        } else {
+            vec![("model".to_string(), p.model.clone().into())]
+        }
+    }
+
     fn plan(p: &Params, _: &BTreeMap<String, String>) -> Vec<Stage> {
         vec![
             Stage {

@@ -100,6 +100,7 @@ fn records_name_each_shard_that_does_not_count() {
             sessions: vec![RecordedSession {
                 dataset: "lab".into(),
                 name: format!("s{k}"),
+                path: PathBuf::from("/logs/lab/s.mcap"),
                 skipped: None,
             }],
         };
