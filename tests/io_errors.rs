@@ -266,8 +266,7 @@ fn read_only_folders_and_unreadable_globs_are_named() {
         out.join(".tmp").display()
     );
     assert!(
-        stderr.starts_with(&format!("error: writing table "))
-            && stderr.trim_end().ends_with(&scratch),
+        stderr.starts_with("error: writing table ") && stderr.trim_end().ends_with(&scratch),
         "{stderr}"
     );
     assert_os_error_once(&stderr);
