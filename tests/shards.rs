@@ -30,11 +30,11 @@ fn check(o: &Output, what: &str) {
 
 fn run(out: &Path, sessions: &str, args: &[&str]) -> Output {
     peopletrack()
-        .args(args)
         .arg("run")
         .arg(pipeline())
         .args(["--sessions", sessions, "--out"])
         .arg(out)
+        .args(args)
         .output()
         .expect("runs")
 }

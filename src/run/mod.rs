@@ -336,6 +336,10 @@ fn plan<E: Experiment>(
         sessions.sort();
     }
     if let Some((k, n)) = opts.shard {
+        if sessions.is_empty() {
+            anyhow::bail!("{}: no sessions match {patterns:?}", path.display());
+        }
+        // a shard may have no session (more shards than sessions): it records that it ran
         sessions = shard::of_shard(sessions, k, n);
     }
     Ok(Plan {
@@ -635,7 +639,7 @@ pub fn run_experiment<E: Experiment>(
         plan: String::new(),
         notices: Vec::new(),
     };
-    if plan.sessions.is_empty() {
+    if plan.sessions.is_empty() && opts.shard.is_none() {
         anyhow::bail!("{}: no sessions match {:?}", path.display(), plan.patterns);
     }
     // a run that writes the pipeline's products holds its folder from here to its end
