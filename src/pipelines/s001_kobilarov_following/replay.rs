@@ -83,16 +83,7 @@ impl LaserSelect {
             .filter_map(|&i| d.legs.get(i).map(|l| l.fixed))
             .collect();
         self.tracker.step(t, &people, &single);
-        let mut out = StepOutput {
-            estimate: None,
-            reset: false,
-            initialised: false,
-            blobs: people.len(),
-            gated: 0,
-            beta0: None,
-            chosen: None,
-            chosen_lr: None,
-        };
+        let mut out = StepOutput::empty(people.len());
         let current = self
             .id
             .and_then(|id| self.tracker.confirmed().find(|tr| tr.id == id));
