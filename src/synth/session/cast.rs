@@ -201,19 +201,9 @@ fn scripted_track(
             lateral_accel,
             accel,
             clearance_m,
-            start: jog_start,
+            start,
             heading_deg,
         } => {
-            let random = (
-                area[0] + r.random::<f64>() * (area[2] - area[0]),
-                area[1] + r.random::<f64>() * (area[3] - area[1]),
-                r.random::<f64>() * std::f64::consts::TAU,
-            );
-            let from = (
-                jog_start.map_or(random.0, |p| p[0]),
-                jog_start.map_or(random.1, |p| p[1]),
-                heading_deg.map_or(random.2, f64::to_radians),
-            );
             let spec = jog::RouteSpec {
                 area: *area,
                 speed: *speed,
@@ -221,21 +211,14 @@ fn scripted_track(
                 max_turn_deg: *max_turn_deg,
                 clearance_m: *clearance_m,
             };
-            let dur = leave - p.enter_s + 10.0;
-            let route = jog::route(
-                (from.0, from.1),
-                from.2,
+            let pace = (*lateral_accel, *accel);
+            let at = (*start, *heading_deg);
+            Ok(jog_track(
                 &spec,
-                dur,
-                &world.obstacles,
-                &mut r,
-            );
-            Ok(jog::run(
-                from,
-                &route.goals,
-                *lateral_accel,
-                *accel,
+                pace,
+                at,
                 (p.enter_s, leave),
+                world,
                 &mut r,
             ))
         }
@@ -254,6 +237,33 @@ fn scripted_track(
                 .map_err(SynthError::Scenario)
         }
     }
+}
+
+/// A `jog` motion's track (`synth::motion::jog`): its route from `at` (start, heading in
+/// degrees; random when absent), then running it with `pace` (lateral acceleration, pace
+/// change) between `span` (enter, leave).
+fn jog_track(
+    spec: &jog::RouteSpec,
+    pace: (f64, f64),
+    at: (Option<[f64; 2]>, Option<f64>),
+    span: (f64, f64),
+    world: &World,
+    r: &mut rand_chacha::ChaCha8Rng,
+) -> Track {
+    let area = spec.area;
+    let random = (
+        area[0] + r.random::<f64>() * (area[2] - area[0]),
+        area[1] + r.random::<f64>() * (area[3] - area[1]),
+        r.random::<f64>() * std::f64::consts::TAU,
+    );
+    let from = (
+        at.0.map_or(random.0, |p| p[0]),
+        at.0.map_or(random.1, |p| p[1]),
+        at.1.map_or(random.2, f64::to_radians),
+    );
+    let dur = span.1 - span.0 + 10.0;
+    let route = jog::route((from.0, from.1), from.2, spec, dur, &world.obstacles, r);
+    jog::run(from, &route.goals, pace.0, pace.1, span, r)
 }
 
 /// A companion runs this far beside the target (m): shoulder to shoulder with a step between.
