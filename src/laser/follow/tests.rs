@@ -63,20 +63,23 @@ fn two_legs_are_one_blob_and_a_wall_is_none() {
 }
 
 /// A person walking at 1.5 m/s across the scan, a still post 1.5 m beside the path: the
-/// follower stays on the person (error under 0.3 m once it has the speed: the track starts at
-/// rest), never resets. With σ_r = 0.6 m the post falls inside the χ² gate while the person
-/// passes it and, without colour, the PDAF's mixture pulls the estimate towards it by up to
-/// ~0.25 m (0.15 m bounded it with σ_r = 0.15 m).
+/// follower never resets, is never captured by the post (at every scan once it has the speed
+/// — the track starts at rest — the estimate is nearer the person than the post) and is back
+/// on the person (error under 0.5 m) 2 s after passing it. With σ_r = 0.6 m the post falls
+/// inside the χ² gate while the person passes it and, without colour, the PDAF's mixture pulls
+/// the estimate towards it: by 0.63 m with CT (it was under 0.15 m with σ_r = 0.15 m) — the
+/// cost of the σ_r the reset timing asks for (docs/s001_kobilarov_following.md, "Real data").
 #[test]
 fn follows_a_walker_past_a_post() {
+    let post = [5.5, 0.5];
     for model in [ModelKind::Cv, ModelKind::Ct, ModelKind::Imm] {
         let mut tr = FollowTracker::new(&params(model), [4.0, -2.0]);
-        let mut worst: f64 = 0.0;
+        let (mut worst, mut last): (f64, f64) = (0.0, f64::NAN);
         for k in 0..40 {
             let t = 0.1 * f64::from(k);
             let y = -2.0 + 1.5 * t;
             let mut world = legs(4.0, y).to_vec();
-            world.push((5.5, 0.5, 0.08));
+            world.push((post[0], post[1], 0.08));
             let pts = scan(&world);
             let out = tr
                 .step(&ScanObs {
@@ -87,11 +90,15 @@ fn follows_a_walker_past_a_post() {
                 .expect("step");
             assert!(!out.reset, "{model:?} reset at {t}");
             let e = out.estimate.expect("tracked");
+            last = (e.position[0] - 3.97).hypot(e.position[1] - y);
             if k > 15 {
-                worst = worst.max((e.position[0] - 3.97).hypot(e.position[1] - y));
+                let to_post = (e.position[0] - post[0]).hypot(e.position[1] - post[1]);
+                assert!(last < to_post, "{model:?} on the post at {t}: {e:?}");
+                worst = worst.max(last);
             }
         }
-        assert!(worst < 0.3, "{model:?}: {worst}");
+        eprintln!("{model:?}: worst {worst:.3} m, at the end {last:.3} m");
+        assert!(last < 0.5, "{model:?}: {last} m at the end");
     }
 }
 
