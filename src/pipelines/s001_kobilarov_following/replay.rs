@@ -35,10 +35,14 @@ impl Runner {
                 association,
                 colour,
                 update,
+                printed,
             } => {
                 let mut fp = p.follower.params(model, association, colour);
                 if update {
                     fp.template_update = p.template_update;
+                }
+                if printed {
+                    fp.corr_form = crate::vision::cylinder::CorrForm::Printed;
                 }
                 Runner::Follower(Box::new(FollowTracker::new(&fp, init)))
             }
