@@ -5,7 +5,7 @@ VENV := target/py-venv
 # py-motmetrics needs numpy 1, OpenCV 4.12 numpy 2: separate throwaway environments
 VENV_MOT := target/py-venv-mot
 
-.PHONY: help eval datasets release test bench interop clean opencv-agreement bench-gmm bench-multicam bench-laser wildtrack
+.PHONY: help eval datasets release test bench interop clean opencv-agreement stonesoup-agreement bench-gmm bench-multicam bench-laser wildtrack
 
 PROFILE ?= quick
 
@@ -18,6 +18,7 @@ help:
 	@echo "make bench-mot tracking metrics: criterion on a synthetic sequence + py-motmetrics on the same files, with the ratio"
 	@echo "make interop   check that Python mcap-ros2-support opens what we write, synthetic datasets included (throwaway venv)"
 	@echo "make opencv-agreement  pixel agreement of vision::gmm masks with OpenCV MOG2, fails below 100 % (throwaway venv)"
+	@echo "make stonesoup-agreement  seed 001's PDAF (CV, CT) and IMM step by step against Stone Soup on real and synthetic scans, fails above 1e-9 (throwaway venv)"
 	@echo "make bench-mlp         appearance-model training (10 splits) beside scikit-learn MLPRegressor, with the ratio"
 	@echo "make bench-gmm         adaptive GMM frames/s beside OpenCV MOG2 on the same frames, with ratios"
 	@echo "make bench-multicam    seed 004: frames/s of the whole s004_mohedano_multicam pipeline per camera and of the Gabor background alone"
@@ -120,6 +121,24 @@ opencv-agreement: $(VENV)/opencv-ok
 		$(CARGO) run --quiet --release --example gmm_masks -- wallflower $(WAVING_TREES) $(GMM_OUT)/waving_trees && \
 		$(VENV)/bin/python tools/opencv_mog2_agreement.py $(GMM_OUT)/waving_trees --min-agreement 100; \
 	else echo "SKIPPED: $(WAVING_TREES) is absent"; fi
+
+# Stone Soup (PyPI) as the reference for track::pdaf: its PDA hypothesiser and updater, and an
+# IMM built from its pieces, on the measurement sequences of the real outdoor following log
+# and a segway_park log; every step must agree to 1e-9 (tools/stonesoup_pdaf_agreement.py).
+VENV_SS := target/py-venv-stonesoup
+PDAF_OUT := target/pdaf-agreement
+REAL_FOLLOWING := ../shared/real/laser/person_following_outdoor_1/person_following_outdoor_1.mcap
+
+$(VENV_SS)/ok:
+	$(PYTHON) -m venv $(VENV_SS)
+	$(VENV_SS)/bin/pip install --quiet --disable-pip-version-check stonesoup==1.9.1 numpy==2.4.6 scipy==1.17.1
+	touch $@
+
+stonesoup-agreement: $(VENV_SS)/ok release
+	./target/release/peopletrack synth --if-absent datasets/segway_park/scenario.toml
+	rm -rf $(PDAF_OUT)
+	$(CARGO) run --quiet --release --example pdaf_agreement -- $(PDAF_OUT) --real $(REAL_FOLLOWING) --synthetic datasets/segway_park/segway_park_00.mcap
+	$(VENV_SS)/bin/python tools/stonesoup_pdaf_agreement.py $(PDAF_OUT) --tol 1e-9
 
 bench-gmm: $(VENV)/opencv-ok
 	$(CARGO) bench --bench gmm -- --noplot

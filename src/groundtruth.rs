@@ -40,6 +40,10 @@ pub struct FollowerState {
     pub desired_distance: f64,
     /// The robot's odometry pose `[x, y, yaw]` at the scan (m, rad).
     pub robot: [f64; 3],
+    /// While the target is lost after `rst`: the last prediction the robot turns towards
+    /// (absent otherwise, and in logs written before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub look_at: Option<[f64; 2]>,
 }
 
 /// What one camera sees of one person.

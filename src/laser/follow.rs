@@ -5,7 +5,18 @@
 //! ([`crate::vision::cylinder`]); a PDAF with a constant-velocity, coordinated-turn or IMM
 //! model, or a nearest-neighbour filter ([`crate::track::pdaf`]), follows the target; when
 //! the position covariance passes the `rst` limit the track is dropped (the robot stops) and
-//! re-initialised on the nearest plausible blob.
+//! re-initialised.
+//!
+//! **Start and re-acquisition.** The track starts on the blob nearest the point the operator
+//! gives (within `init_radius_m`); the colour template is taken there (or, when no omni frame
+//! is there yet, on the first accepted scan that has one) and held, or updated with weight
+//! `template_update` per accepted scan. After `rst` the follower looks within a radius of the
+//! last prediction that grows at `v_max` from `reinit_radius_m` to `reinit_max_m`: with colour,
+//! it takes the blob with the highest likelihood ratio among those whose **normalised**
+//! correlation with the template is at least `reacquire_corr` (seed 001 §VI: descriptors kept
+//! "so that the tracker can reacquire the correct human"); when none passes it stays lost —
+//! the robot stops and turns towards the last prediction ([`StepOutput::look_at`]) — and keeps
+//! looking. Without colour (or before any template) it takes the nearest blob, as at the start.
 //!
 //! **Blobs** (our reading of "connected components that might have originated from people"):
 //! jump-distance segments ([`crate::laser::segment`]) merged while the gap between the end of
@@ -26,7 +37,11 @@ use crate::laser::segment::{self, SegmentOptions, Threshold};
 use serde::{Deserialize, Serialize};
 
 use crate::track::pdaf::{AssociationKind, FilterError, FilterParams, ModelKind, TargetFilter};
-use crate::vision::cylinder::{self, CylinderMap};
+use crate::vision::cylinder::{self, CorrForm, CylinderMap};
+
+/// The default floor on the normalised correlation (a correlation coefficient, ≤ 1) with the
+/// template for re-acquisition after `rst`: see `FollowParams::default`.
+pub const REACQUIRE_CORR: f64 = 0.5;
 
 /// Parameters of the follower (the filter's inside).
 #[derive(Debug, Clone, PartialEq)]
@@ -47,6 +62,12 @@ pub struct FollowParams {
     pub roi_half_height_m: f64,
     /// The paper's corr_min ("a small negative number").
     pub corr_min: f64,
+    /// Which correlation the likelihood ratio uses (normalised by default; `Printed` is the
+    /// formula as printed, see [`crate::vision::cylinder`]).
+    pub corr_form: CorrForm,
+    /// Re-acquisition after `rst` with colour: the least normalised correlation with the
+    /// template a blob needs.
+    pub reacquire_corr: f64,
     /// Template update weight per accepted scan (0: the template stays as initialised).
     pub template_update: f64,
     /// The first blob must lie this close to the initial point (m).
@@ -61,7 +82,9 @@ pub struct FollowParams {
 
 impl Default for FollowParams {
     /// Chosen a priori (not searched): blobs as wide as a person with both legs, the chest at
-    /// 1.3 m for a 1.8 m person, ±0.3 m of torso, corr_min −0.1.
+    /// 1.3 m for a 1.8 m person, ±0.3 m of torso, corr_min −0.1; the normalised correlation
+    /// (the paper's text); re-acquisition on a normalised correlation of at least
+    /// [`REACQUIRE_CORR`] within a radius growing to the blobs' `max_range_m`.
     fn default() -> Self {
         FollowParams {
             filter: FilterParams::default(),
@@ -75,10 +98,12 @@ impl Default for FollowParams {
             chest_height_m: 1.3,
             roi_half_height_m: 0.3,
             corr_min: -0.1,
+            corr_form: CorrForm::Normalised,
+            reacquire_corr: REACQUIRE_CORR,
             template_update: 0.0,
             init_radius_m: 1.0,
             reinit_radius_m: 1.5,
-            reinit_max_m: 4.0,
+            reinit_max_m: 10.0,
             cylinder: [720, 120],
         }
     }
@@ -111,6 +136,8 @@ pub struct FollowSpec {
     pub chest_height_m: f64,
     pub roi_half_height_m: f64,
     pub corr_min: f64,
+    pub corr_form: CorrForm,
+    pub reacquire_corr: f64,
     pub template_update: f64,
     pub init_radius_m: f64,
     pub reinit_radius_m: f64,
@@ -143,6 +170,8 @@ impl Default for FollowSpec {
             chest_height_m: p.chest_height_m,
             roi_half_height_m: p.roi_half_height_m,
             corr_min: p.corr_min,
+            corr_form: p.corr_form,
+            reacquire_corr: p.reacquire_corr,
             template_update: p.template_update,
             init_radius_m: p.init_radius_m,
             reinit_radius_m: p.reinit_radius_m,
@@ -186,6 +215,8 @@ impl FollowSpec {
             chest_height_m: self.chest_height_m,
             roi_half_height_m: self.roi_half_height_m,
             corr_min: self.corr_min,
+            corr_form: self.corr_form,
+            reacquire_corr: self.reacquire_corr,
             template_update: self.template_update,
             init_radius_m: self.init_radius_m,
             reinit_radius_m: self.reinit_radius_m,
@@ -230,6 +261,15 @@ impl FollowSpec {
             out.push((
                 "clutter_density".into(),
                 format!("{} must be finite and >= 0", self.clutter_density),
+            ));
+        }
+        if !(self.reacquire_corr.is_finite() && self.reacquire_corr <= 1.0) {
+            out.push((
+                "reacquire_corr".into(),
+                format!(
+                    "{} must be finite and <= 1 (a correlation coefficient)",
+                    self.reacquire_corr
+                ),
             ));
         }
         if !(self.corr_min.is_finite() && self.corr_min <= 0.0) {
@@ -343,6 +383,32 @@ pub struct StepOutput {
     pub chosen: Option<Blob>,
     /// Its likelihood ratio (1 without colour).
     pub chosen_lr: Option<f64>,
+    /// Its normalised correlation with the template (colour, template and image present).
+    pub chosen_corr: Option<f64>,
+    /// While lost after `rst`: the last prediction, which the robot turns towards.
+    pub look_at: Option<[f64; 2]>,
+    /// Every blob's centre and normalised correlation with the template (colour, template and
+    /// a histogram present), for the colour diagnostics.
+    pub blob_corr: Vec<([f64; 2], f64)>,
+}
+
+impl StepOutput {
+    /// A scan with `blobs` blobs and nothing else yet.
+    pub fn empty(blobs: usize) -> StepOutput {
+        StepOutput {
+            estimate: None,
+            reset: false,
+            initialised: false,
+            blobs,
+            gated: 0,
+            beta0: None,
+            chosen: None,
+            chosen_lr: None,
+            chosen_corr: None,
+            look_at: None,
+            blob_corr: Vec::new(),
+        }
+    }
 }
 
 /// The follower's state.
@@ -356,6 +422,15 @@ pub struct FollowTracker {
     lost_at: Option<f64>,
     started: bool,
     map: Option<CylinderMap>,
+}
+
+/// One scan's blobs with what colour says about them.
+struct Seen<'a> {
+    blobs: &'a [Blob],
+    hists: &'a [Option<Vec<f64>>],
+    lr: &'a [f64],
+    /// Normalised correlation with the template, per blob.
+    corr: &'a [Option<f64>],
 }
 
 impl FollowTracker {
@@ -409,14 +484,17 @@ impl FollowTracker {
             .collect()
     }
 
-    fn likelihood_ratios(&self, hists: &[Option<Vec<f64>>]) -> Vec<f64> {
+    /// Each histogram's correlation with the template in the configured form and in the
+    /// normalised form (`None` without a histogram or a template).
+    fn correlations(&self, hists: &[Option<Vec<f64>>]) -> Vec<Option<(f64, f64)>> {
         hists
             .iter()
-            .map(|h| match (h, &self.template) {
-                (Some(h), Some(t)) => {
-                    cylinder::likelihood_ratio(cylinder::corr(h, t), self.params.corr_min)
-                }
-                _ => 1.0,
+            .map(|h| {
+                let (h, t) = (h.as_ref()?, self.template.as_ref()?);
+                Some((
+                    self.params.corr_form.corr(h, t),
+                    cylinder::corr_normalised(h, t),
+                ))
             })
             .collect()
     }
@@ -425,19 +503,30 @@ impl FollowTracker {
     pub fn step(&mut self, obs: &ScanObs<'_>) -> Result<StepOutput, FilterError> {
         let bl = blobs(obs.points, &self.params);
         let hists = self.histograms(&bl, obs.omni.as_ref());
-        let lr = self.likelihood_ratios(&hists);
-        let mut out = StepOutput {
-            estimate: None,
-            reset: false,
-            initialised: false,
-            blobs: bl.len(),
-            gated: 0,
-            beta0: None,
-            chosen: None,
-            chosen_lr: None,
+        let corrs = self.correlations(&hists);
+        let lr: Vec<f64> = corrs
+            .iter()
+            .map(|c| {
+                c.map_or(1.0, |(c, _)| {
+                    cylinder::likelihood_ratio(c, self.params.corr_min)
+                })
+            })
+            .collect();
+        let corr: Vec<Option<f64>> = corrs.iter().map(|c| c.map(|(_, n)| n)).collect();
+        let mut out = StepOutput::empty(bl.len());
+        out.blob_corr = bl
+            .iter()
+            .zip(&corr)
+            .filter_map(|(b, c)| Some((b.centre, (*c)?)))
+            .collect();
+        let seen = Seen {
+            blobs: &bl,
+            hists: &hists,
+            lr: &lr,
+            corr: &corr,
         };
         let Some(filter) = self.filter.as_mut() else {
-            self.initialise(obs.t, &bl, &hists, &lr, &mut out);
+            self.initialise(obs.t, &seen, &mut out);
             return Ok(out);
         };
         filter.predict(obs.t)?;
@@ -445,65 +534,95 @@ impl FollowTracker {
         let a = filter.update(&z, &lr)?;
         out.gated = a.gated.len();
         out.beta0 = Some(a.beta0);
+        let needs_reset = filter.needs_reset();
+        let (position, estimate) = (filter.position(), estimate_of(filter));
         if let Some(j) = a.chosen {
             out.chosen = bl.get(j).copied();
             out.chosen_lr = lr.get(j).copied();
-            let w = self.params.template_update;
-            if w > 0.0
-                && let (Some(t), Some(Some(h))) = (self.template.as_mut(), hists.get(j))
-            {
-                t.iter_mut()
-                    .zip(h)
-                    .for_each(|(t, h)| *t = (1.0 - w) * *t + w * h);
-            }
+            out.chosen_corr = corr.get(j).copied().flatten();
+            self.learn_template(hists.get(j).and_then(Option::as_ref));
         }
-        if filter.needs_reset() {
+        if needs_reset {
             out.reset = true;
-            self.anchor = filter.position();
+            self.anchor = position;
             self.lost_at = Some(obs.t);
             self.filter = None;
+            out.look_at = Some(self.anchor);
             return Ok(out);
         }
-        out.estimate = Some(estimate_of(filter));
+        out.estimate = Some(estimate);
         Ok(out)
     }
 
-    /// Start (or restart after `rst`) on the nearest plausible blob.
-    fn initialise(
-        &mut self,
-        t: f64,
-        bl: &[Blob],
-        hists: &[Option<Vec<f64>>],
-        lr: &[f64],
-        out: &mut StepOutput,
-    ) {
+    /// The template from the accepted blob's histogram: taken when there is none yet (no
+    /// omni frame at initialisation), blended with weight `template_update` otherwise.
+    fn learn_template(&mut self, h: Option<&Vec<f64>>) {
+        let Some(h) = h else { return };
+        let w = self.params.template_update;
+        match self.template.as_mut() {
+            None => self.template = Some(h.clone()),
+            Some(t) if w > 0.0 => t
+                .iter_mut()
+                .zip(h)
+                .for_each(|(t, h)| *t = (1.0 - w) * *t + w * h),
+            Some(_) => {}
+        }
+    }
+
+    /// Start (or restart after `rst`): see the module doc.
+    fn initialise(&mut self, t: f64, seen: &Seen<'_>, out: &mut StepOutput) {
         let radius = match (self.started, self.lost_at) {
             (false, _) => self.params.init_radius_m,
             (true, lost) => (self.params.reinit_radius_m
                 + self.params.filter.v_max * lost.map_or(0.0, |l| (t - l).max(0.0)))
             .min(self.params.reinit_max_m),
         };
-        let d = |b: &Blob| (b.centre[0] - self.anchor[0]).hypot(b.centre[1] - self.anchor[1]);
-        let pick = bl
-            .iter()
-            .enumerate()
-            .filter(|(j, b)| d(b) <= radius && lr.get(*j).is_some_and(|&l| l > 0.0))
-            .min_by(|a, b| d(a.1).total_cmp(&d(b.1)));
-        let Some((j, b)) = pick else { return };
+        let by_colour = self.started && self.params.colour && self.template.is_some();
+        let floor = by_colour.then_some(self.params.reacquire_corr);
+        let pick = pick_blob(seen, self.anchor, radius, floor).map(|j| (j, &seen.blobs[j]));
+        let Some((j, b)) = pick else {
+            out.look_at = self.started.then_some(self.anchor);
+            return;
+        };
         let filter = TargetFilter::new(&self.params.filter, t, b.centre);
         if self.template.is_none()
-            && let Some(Some(h)) = hists.get(j)
+            && let Some(Some(h)) = seen.hists.get(j)
         {
             self.template = Some(h.clone());
         }
         out.initialised = true;
         out.chosen = Some(*b);
-        out.chosen_lr = lr.get(j).copied();
+        out.chosen_lr = seen.lr.get(j).copied();
+        out.chosen_corr = seen.corr.get(j).copied().flatten();
         out.estimate = Some(estimate_of(&filter));
         self.filter = Some(filter);
         self.started = true;
         self.lost_at = None;
     }
+}
+
+/// The blob a (re)start takes (see the module doc): within `radius` of `anchor` and with a
+/// positive likelihood ratio; with a colour `floor`, the one with the highest likelihood ratio
+/// among those whose normalised correlation reaches the floor (ties to the nearer), else the
+/// nearest. `None`: nothing qualifies.
+fn pick_blob(seen: &Seen<'_>, anchor: [f64; 2], radius: f64, floor: Option<f64>) -> Option<usize> {
+    let d = |b: &Blob| (b.centre[0] - anchor[0]).hypot(b.centre[1] - anchor[1]);
+    let ok = |j: usize, b: &Blob| {
+        d(b) <= radius
+            && seen.lr.get(j).is_some_and(|&l| l > 0.0)
+            && floor.is_none_or(|f| seen.corr.get(j).copied().flatten().is_some_and(|c| c >= f))
+    };
+    let candidates = seen.blobs.iter().enumerate().filter(|(j, b)| ok(*j, b));
+    let pick = if floor.is_some() {
+        candidates.max_by(|a, b| {
+            seen.lr[a.0]
+                .total_cmp(&seen.lr[b.0])
+                .then(d(b.1).total_cmp(&d(a.1)))
+        })
+    } else {
+        candidates.min_by(|a, b| d(a.1).total_cmp(&d(b.1)))
+    };
+    pick.map(|(j, _)| j)
 }
 
 fn estimate_of(f: &TargetFilter) -> Estimate {

@@ -1,8 +1,9 @@
 //! How people move: a walker that heads for goals with human speeds, accelerations and turn
 //! rates, slowing to stop where it pauses, with a gait phase that advances with distance; goal
 //! lists from waypoints, random wandering that avoids obstacles, visitors who enter and leave
-//! by doors, passers-by crossing between a robot and its target; and replay of real recorded
-//! trajectories (`frame id x y` at 2.5 Hz, interpolated with Catmull–Rom splines).
+//! by doors, passers-by crossing between a robot and its target; a cooperating jogger's route
+//! and the people who run beside them ([`jog`]); and replay of real recorded trajectories
+//! (`frame id x y` at 2.5 Hz, interpolated with Catmull–Rom splines).
 //!
 //! Tracks are sampled every 10 ms once, before any sensor runs, so sensors are pure functions
 //! of time and can be rendered in any order.
@@ -14,6 +15,8 @@ use rand_chacha::ChaCha8Rng;
 
 use super::person::{Body, PersonState};
 use super::world::Obstacle;
+
+pub mod jog;
 
 /// Sample period of tracks (s).
 pub const DT: f64 = 0.01;

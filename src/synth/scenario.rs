@@ -265,6 +265,25 @@ pub enum Motion {
         #[serde(default)]
         start: Option<[f64; 2]>,
     },
+    /// A cooperating runner's route (`synth::motion::jog`): straight stretches of `stretch_m`
+    /// at a pace from `speed`, clear of trees and bushes by `clearance_m`, inside `area`, each
+    /// turning by at most `max_turn_deg`; heading rate bounded by `lateral_accel / v`, pace
+    /// changes at `accel`. Starts at `start` heading `heading_deg` (absent: random).
+    Jog {
+        area: [f64; 4],
+        speed: [f64; 2],
+        stretch_m: [f64; 2],
+        #[serde(default = "default_max_turn_deg")]
+        max_turn_deg: f64,
+        #[serde(default = "default_lateral_accel")]
+        lateral_accel: f64,
+        #[serde(default = "default_jog_accel")]
+        accel: f64,
+        #[serde(default = "default_clearance")]
+        clearance_m: f64,
+        start: Option<[f64; 2]>,
+        heading_deg: Option<f64>,
+    },
     /// Replay a real trajectory (`frame id x y` at 2.5 Hz, e.g. ../shared/real/eth_ucy/*.txt),
     /// moved by `offset` and turned by `rotate_deg`.
     Replay {
@@ -275,6 +294,19 @@ pub enum Motion {
         #[serde(default)]
         rotate_deg: f64,
     },
+}
+
+fn default_max_turn_deg() -> f64 {
+    90.0
+}
+fn default_lateral_accel() -> f64 {
+    2.0
+}
+fn default_jog_accel() -> f64 {
+    1.0
+}
+fn default_clearance() -> f64 {
+    0.6
 }
 
 /// `[[people]]`: one scripted person.
@@ -339,6 +371,10 @@ pub struct Crowd {
     pub use_doors: bool,
     /// Cross the line between the robot and this person (outdoor following).
     pub cross_between_robot_and: Option<u32>,
+    /// Of those, how many (the first ones) first run beside that person, then cross between
+    /// the robot and them (`synth::motion::jog::companion`).
+    #[serde(default)]
+    pub companions: u32,
 }
 
 fn default_heights() -> [f64; 2] {
@@ -643,6 +679,9 @@ impl Scenario {
                     "needs at least one point and a speed in (0, 4] m/s".into(),
                 );
             }
+            if let Some(r) = jog_problem(&p.motion) {
+                return bad(&format!("people[{i}].motion"), r);
+            }
         }
         for (i, s) in self.sensors.iter().enumerate() {
             if !(s.rate_hz() > 0.0 && s.rate_hz() <= 1000.0) {
@@ -707,4 +746,36 @@ impl Scenario {
         }
         Ok(())
     }
+}
+
+/// The first problem of a `jog` motion's values.
+fn jog_problem(m: &Motion) -> Option<String> {
+    let Motion::Jog {
+        area,
+        speed,
+        stretch_m,
+        max_turn_deg,
+        lateral_accel,
+        accel,
+        clearance_m,
+        ..
+    } = m
+    else {
+        return None;
+    };
+    let ok = area[0] < area[2]
+        && area[1] < area[3]
+        && speed[0] > 0.0
+        && speed[0] <= speed[1]
+        && speed[1] <= 6.0
+        && stretch_m[0] > 0.0
+        && stretch_m[0] <= stretch_m[1]
+        && *max_turn_deg > 0.0
+        && *max_turn_deg <= 180.0
+        && *lateral_accel > 0.0
+        && *accel > 0.0
+        && *clearance_m >= 0.0;
+    (!ok).then(|| {
+        "jog needs an area [x0, y0, x1, y1], 0 < speed[0] <= speed[1] <= 6 m/s, 0 < stretch_m[0] <= stretch_m[1], 0 < max_turn_deg <= 180, positive lateral_accel and accel, clearance_m >= 0".into()
+    })
 }

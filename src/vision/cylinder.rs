@@ -14,9 +14,14 @@
 //!   extent is that of the blob's middle lifted to h ± `half_height_m` instead.
 //! - **Histogram** H: 8 hue × 8 saturation bins ([`ColorSpace::Hs`]) of the ring pixels in the
 //!   ROI, normalised to sum 1, then its mean (1/64) subtracted from every bin, as printed.
-//! - **corr** as printed: Σ H_i H_j / (Σ H_i² · Σ H_j²) — without a square root, so it is not
-//!   bounded by 1 (identical histograms give 1 / Σ H²); [`corr_normalised`] has the root (the
-//!   usual correlation coefficient, ≤ 1) for comparison.
+//! - **corr** ([`CorrForm`]): the default is the normalised form Σ H_i H_j / √(Σ H_i² · Σ H_j²)
+//!   ([`corr_normalised`], the correlation coefficient of the two mean-subtracted histograms,
+//!   ≤ 1, and 1 for a histogram with itself). The paper's own text asks for it: "the highest
+//!   correlation between two histograms is one", and its clutter density 1/(1 − corr_min) is
+//!   uniform over [corr_min, 1]. The formula as printed, Σ H_i H_j / (Σ H_i² · Σ H_j²)
+//!   ([`corr`], no square root), is kept as the named variant [`CorrForm::Printed`]: it is not
+//!   bounded by 1 (identical histograms give 1 / Σ H²), so flat histograms — small Σ H² —
+//!   score higher than peaked ones.
 //! - **lr** = max(corr, 0) · (1 − corr_min): the paper's γ_T / γ_C with γ_C = 1 / (1 − corr_min).
 //!
 //! Written by hand: a handful of trigonometric samples per region, which no image crate does.
@@ -29,6 +34,27 @@ use crate::vision::colortrack::ColorSpace;
 
 /// Number of bins of the hue–saturation histogram.
 pub const HS_BINS: usize = 64;
+
+/// Which form of the paper's histogram correlation (see the module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CorrForm {
+    /// Σ a·b / √(Σ a² · Σ b²), ≤ 1 (the paper's text; the default).
+    #[default]
+    Normalised,
+    /// Σ a·b / (Σ a² · Σ b²), as printed (not bounded by 1).
+    Printed,
+}
+
+impl CorrForm {
+    /// The correlation of two histograms in this form.
+    pub fn corr(self, a: &[f64], b: &[f64]) -> f64 {
+        match self {
+            CorrForm::Normalised => corr_normalised(a, b),
+            CorrForm::Printed => corr(a, b),
+        }
+    }
+}
 
 /// Elevation (rad) of an image radius `r` on the mirror: the inverse of r = f(sec φ − tan φ).
 pub fn elevation_of_radius(model: &Paracatadioptric, r: f64) -> f64 {
@@ -311,6 +337,14 @@ mod tests {
         assert_eq!(corr(&a, &[0.0; 4]), 0.0);
         // lr = max(corr, 0) (1 - corr_min)
         assert!((likelihood_ratio(4.0, -0.1) - 4.4).abs() < 1e-12);
+        // the forms by name
+        assert!((CorrForm::Normalised.corr(&a, &a) - 1.0).abs() < 1e-12);
+        assert!((CorrForm::Printed.corr(&a, &a) - 4.0).abs() < 1e-12);
+        // the printed form rewards flatness: the same shape at a fifth of the contrast scores
+        // 20 against `a`, five times `a`'s match with itself; the normalised form says 1 to both
+        let flat = normalise(vec![3.0, 3.0, 2.0, 2.0]);
+        assert!((CorrForm::Printed.corr(&flat, &a) - 20.0).abs() < 1e-9);
+        assert!((CorrForm::Normalised.corr(&flat, &a) - 1.0).abs() < 1e-12);
         assert_eq!(likelihood_ratio(-4.0, -0.1), 0.0);
         assert_eq!(likelihood_ratio(f64::NAN, -0.1), 0.0);
     }

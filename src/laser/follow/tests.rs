@@ -62,18 +62,24 @@ fn two_legs_are_one_blob_and_a_wall_is_none() {
     assert!(b.width > 0.2 && b.width < 0.4);
 }
 
-/// A person walking at 1.5 m/s across the scan, a still post beside the path: the follower
-/// stays on the person (error under 0.15 m), never resets.
+/// A person walking at 1.5 m/s across the scan, a still post 1.5 m beside the path: the
+/// follower never resets, is never captured by the post (at every scan once it has the speed
+/// — the track starts at rest — the estimate is nearer the person than the post) and is back
+/// on the person (error under 0.5 m) 2 s after passing it. With σ_r = 0.6 m the post falls
+/// inside the χ² gate while the person passes it and, without colour, the PDAF's mixture pulls
+/// the estimate towards it: by 0.63 m with CT (it was under 0.15 m with σ_r = 0.15 m) — the
+/// cost of the σ_r the reset timing asks for (docs/s001_kobilarov_following.md, "Real data").
 #[test]
 fn follows_a_walker_past_a_post() {
+    let post = [5.5, 0.5];
     for model in [ModelKind::Cv, ModelKind::Ct, ModelKind::Imm] {
         let mut tr = FollowTracker::new(&params(model), [4.0, -2.0]);
-        let mut worst: f64 = 0.0;
+        let (mut worst, mut last): (f64, f64) = (0.0, f64::NAN);
         for k in 0..40 {
             let t = 0.1 * f64::from(k);
             let y = -2.0 + 1.5 * t;
             let mut world = legs(4.0, y).to_vec();
-            world.push((5.5, 0.5, 0.08));
+            world.push((post[0], post[1], 0.08));
             let pts = scan(&world);
             let out = tr
                 .step(&ScanObs {
@@ -84,11 +90,15 @@ fn follows_a_walker_past_a_post() {
                 .expect("step");
             assert!(!out.reset, "{model:?} reset at {t}");
             let e = out.estimate.expect("tracked");
-            if k > 5 {
-                worst = worst.max((e.position[0] - 3.97).hypot(e.position[1] - y));
+            last = (e.position[0] - 3.97).hypot(e.position[1] - y);
+            if k > 15 {
+                let to_post = (e.position[0] - post[0]).hypot(e.position[1] - post[1]);
+                assert!(last < to_post, "{model:?} on the post at {t}: {e:?}");
+                worst = worst.max(last);
             }
         }
-        assert!(worst < 0.15, "{model:?}: {worst}");
+        eprintln!("{model:?}: worst {worst:.3} m, at the end {last:.3} m");
+        assert!(last < 0.5, "{model:?}: {last} m at the end");
     }
 }
 
@@ -127,4 +137,83 @@ fn reset_then_reinitialise_on_the_nearest_blob() {
     let r = reset_at.expect("rst fired while the person was gone");
     assert!((10..60).contains(&r), "rst at {r}");
     assert!(restarted);
+}
+
+fn blob_at(x: f64, y: f64) -> Blob {
+    Blob {
+        centre: [x, y],
+        left: [x, y - 0.15],
+        right: [x, y + 0.15],
+        width: 0.3,
+        points: 10,
+        range: x.hypot(y),
+    }
+}
+
+/// Re-acquisition by colour: among the blobs in reach whose normalised correlation passes the
+/// floor, the highest likelihood ratio wins — not the nearest; a blob out of reach, below the
+/// floor, without a histogram or with lr = 0 never does; none passing: stay lost. Without a
+/// floor (no colour), the nearest blob in reach with lr > 0.
+#[test]
+fn reacquisition_takes_the_best_colour_match_above_the_floor() {
+    let blobs = [
+        blob_at(1.0, 0.0), // nearest, poor colour (a tree)
+        blob_at(2.0, 0.0), // the target's colour
+        blob_at(3.0, 0.0), // matching colour but out of reach
+        blob_at(2.5, 0.0), // good colour, a little worse
+        blob_at(1.5, 0.0), // no histogram
+    ];
+    let hists = vec![None; blobs.len()];
+    let lr = [0.2, 1.05, 1.1, 0.9, 1.0];
+    let corr = [Some(0.2), Some(0.95), Some(1.0), Some(0.8), None];
+    let seen = Seen {
+        blobs: &blobs,
+        hists: &hists,
+        lr: &lr,
+        corr: &corr,
+    };
+    let anchor = [0.0, 0.0];
+    assert_eq!(pick_blob(&seen, anchor, 2.6, Some(0.5)), Some(1));
+    // a higher floor leaves only the one out of reach: stay lost
+    assert_eq!(pick_blob(&seen, anchor, 2.6, Some(0.97)), None);
+    // and in reach it is taken
+    assert_eq!(pick_blob(&seen, anchor, 3.5, Some(0.97)), Some(2));
+    // no colour: the nearest in reach
+    assert_eq!(pick_blob(&seen, anchor, 2.6, None), Some(0));
+    let zero = [0.0, 1.05, 1.1, 0.9, 1.0];
+    let seen = Seen { lr: &zero, ..seen };
+    assert_eq!(pick_blob(&seen, anchor, 2.6, None), Some(4));
+}
+
+/// While lost after `rst` with nothing to re-acquire, every scan reports the last prediction
+/// (the robot turns towards it) and no estimate.
+#[test]
+fn a_lost_follower_reports_where_it_lost_the_target() {
+    let mut tr = FollowTracker::new(&params(ModelKind::Ct), [3.0, 0.0]);
+    let mut reset_look = None;
+    for k in 0..80 {
+        let t = 0.1 * f64::from(k);
+        let world = if k < 10 {
+            legs(3.0, 0.0).to_vec()
+        } else {
+            Vec::new()
+        };
+        let pts = scan(&world);
+        let out = tr
+            .step(&ScanObs {
+                t,
+                points: &pts,
+                omni: None,
+            })
+            .expect("step");
+        if out.reset {
+            reset_look = out.look_at;
+        }
+        if reset_look.is_some() && !out.reset {
+            assert_eq!(out.estimate, None);
+            assert_eq!(out.look_at, reset_look, "scan {k}");
+        }
+    }
+    let at = reset_look.expect("rst fired");
+    assert!((at[0] - 2.97).abs() < 0.1 && at[1].abs() < 0.1, "{at:?}");
 }

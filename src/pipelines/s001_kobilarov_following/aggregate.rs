@@ -1,7 +1,7 @@
 //! The aggregation: every session's cached tables read back, then the products in order —
 //! Table I and the `rst` events ([`super::table1`]), the replayed methods and their t-tests
-//! ([`super::compare`]), method 1's loss rate ([`super::method1`]), the real log
-//! ([`super::real`]) and the figures ([`super::figures`]).
+//! ([`super::compare`]), the colour separation ([`super::colour`]), method 1's loss rate
+//! ([`super::method1`]), the real log ([`super::real`]) and the figures ([`super::figures`]).
 
 use super::params::Params;
 use super::tables::{Method1Row, SessionData, load};
@@ -14,6 +14,7 @@ pub fn products(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     let mut out = Products::default();
     out.tables.extend(super::table1::tables(&synthetic, p)?);
     out.tables.extend(super::compare::tables(&synthetic, p)?);
+    out.tables.push(super::colour::table(&synthetic, p)?);
     let m1: Vec<Method1Row> = synthetic
         .iter()
         .flat_map(|d| d.method1.iter().cloned())

@@ -9,7 +9,12 @@
 //! - **template** (held as initialised vs updated while tracking, CT with colour): wrong-target
 //!   locks and mean error per run;
 //! - **association** (PDAF vs nearest neighbour, CT without colour): the mean error per run and
-//!   after each occlusion.
+//!   after each occlusion;
+//! - **corr** (normalised, the default, vs as printed, CT with colour): share of scans on the
+//!   person and wrong-target locks per run.
+//!
+//! Every family's p-values are corrected together for multiple comparisons (Holm's step-down,
+//! `eval::stats::holm`, over all the rows of the table): `p_holm`.
 //!
 //! A method without an estimate in an event's window leaves that event out of its pairs.
 //! `replay_check` compares the replay of the paper's configuration with what the robot itself
@@ -39,6 +44,9 @@ table_row! {
         pub wrong_lock: f64,
         pub wrong_lock_events: i64,
         pub rst: i64,
+        /// After each `rst`, whether the first estimate lay on the person (`right`) or not.
+        pub reacq_right: i64,
+        pub reacq_wrong: i64,
     }
 }
 
@@ -56,6 +64,8 @@ table_row! {
         pub mean_b: Option<f64>,
         pub t: Option<f64>,
         pub p_two_sided: Option<f64>,
+        /// Holm-adjusted over every test of the table.
+        pub p_holm: Option<f64>,
     }
 }
 
@@ -79,8 +89,29 @@ fn wrong(r: &TrackRow, p: &Params) -> bool {
         && r.nearest_m.is_some_and(|d| d <= p.lock_m)
 }
 
+/// Re-acquisitions after `rst`: (right, wrong) — the first estimate after each reset within
+/// `lock_m` of the person or not.
+pub fn reacquisitions(rows: &[&TrackRow], p: &Params) -> (i64, i64) {
+    let (mut right, mut wrong) = (0, 0);
+    let mut pending = false;
+    for r in rows {
+        if r.reset {
+            pending = true;
+        } else if pending && r.x.is_some() {
+            pending = false;
+            if r.target_err_m.is_some_and(|e| e <= p.lock_m) {
+                right += 1;
+            } else {
+                wrong += 1;
+            }
+        }
+    }
+    (right, wrong)
+}
+
 fn method_row(d: &SessionData, m: &str, p: &Params) -> MethodRow {
     let rows: Vec<&TrackRow> = d.method(m).collect();
+    let (reacq_right, reacq_wrong) = reacquisitions(&rows, p);
     let n = rows.len().max(1) as f64;
     let mut errs: Vec<f64> = rows.iter().filter_map(|r| r.target_err_m).collect();
     errs.sort_by(f64::total_cmp);
@@ -108,6 +139,8 @@ fn method_row(d: &SessionData, m: &str, p: &Params) -> MethodRow {
         wrong_lock: rows.iter().filter(|r| wrong(r, p)).count() as f64 / n,
         wrong_lock_events: events,
         rst: rows.iter().filter(|r| r.reset).count() as i64,
+        reacq_right,
+        reacq_wrong,
     }
 }
 
@@ -181,7 +214,22 @@ fn paired(
         mean_b: mean(&xb),
         t: test.as_ref().map(|t| t.t),
         p_two_sided: test.as_ref().map(|t| t.p_two_sided),
+        p_holm: None,
     }
+}
+
+/// Holm's adjustment over every row that has a p-value.
+fn with_holm(mut rows: Vec<TestRow>) -> Vec<TestRow> {
+    let idx: Vec<usize> = (0..rows.len())
+        .filter(|&i| rows[i].p_two_sided.is_some_and(f64::is_finite))
+        .collect();
+    let ps: Vec<f64> = idx.iter().filter_map(|&i| rows[i].p_two_sided).collect();
+    if let Ok(adj) = stats::holm(&ps) {
+        for (&i, a) in idx.iter().zip(adj) {
+            rows[i].p_holm = Some(a);
+        }
+    }
+    rows
 }
 
 /// The three groups of t-tests (see the module doc); methods absent from the run are skipped.
@@ -249,6 +297,39 @@ pub fn ttests(data: &[&SessionData], p: &Params) -> Vec<TestRow> {
             "locked on another person at the window's end (0/1)",
             (c, &events(c, &locked)),
             (nc, &events(nc, &locked)),
+            lvl,
+        ));
+    }
+    if has(c) && has(nc) {
+        let f = |r: &MethodRow| Some(r.on_target);
+        out.push(paired(
+            "colour likelihood: on the person",
+            "run",
+            "share of scans within lock_m of the person",
+            (c, &per_run(c, &f)),
+            (nc, &per_run(nc, &f)),
+            lvl,
+        ));
+    }
+    let pr = params::PRINTED;
+    if has(c) && has(pr) {
+        let q = "corr: normalised vs as printed";
+        let f = |r: &MethodRow| Some(r.on_target);
+        out.push(paired(
+            q,
+            "run",
+            "share of scans within lock_m of the person",
+            (c, &per_run(c, &f)),
+            (pr, &per_run(pr, &f)),
+            lvl,
+        ));
+        let f = |r: &MethodRow| Some(r.wrong_lock);
+        out.push(paired(
+            q,
+            "run",
+            "share of scans locked on another person",
+            (c, &per_run(c, &f)),
+            (pr, &per_run(pr, &f)),
             lvl,
         ));
     }
@@ -356,14 +437,14 @@ pub fn tables(data: &[&SessionData], p: &Params) -> anyhow::Result<Vec<Table>> {
     ));
     let mut tt = Table::new(
         "ttests",
-        "Paired t-tests: CV vs CT vs IMM after occlusions, colour vs no colour on wrong-target locks, PDAF vs nearest neighbour",
-        TestRow::frame(&ttests(data, p))?,
+        "Paired t-tests: CV vs CT vs IMM after occlusions, colour vs no colour, held vs updated template, normalised vs printed corr, PDAF vs nearest neighbour (Holm-adjusted)",
+        TestRow::frame(&with_holm(ttests(data, p)))?,
     );
-    for c in ["mean_a", "mean_b", "t", "p_two_sided"] {
+    for c in ["mean_a", "mean_b", "t", "p_two_sided", "p_holm"] {
         tt = tt.with_precision(c, 4);
     }
     let tt = tt.with_note(format!(
-        "Occlusion: another person within {} m (beyond their radius) of the laser's line of sight to the target for at least {} s (ground truth); window {} s after it ends. Pairs with a side lacking an estimate are left out (n).",
+        "Occlusion: another person within {} m (beyond their radius) of the laser's line of sight to the target for at least {} s (ground truth); window {} s after it ends. Pairs with a side lacking an estimate are left out (n). p_holm: Holm's step-down adjustment over every test in this table.",
         p.occlusion_margin_m, p.min_occlusion_s, p.after_occlusion_s
     ));
     let mut tr = Table::new(

@@ -9,11 +9,14 @@
 //! the laser issue's tracker), the ground truth and the laser's view of the person
 //! ([`scene`]), method 1 on the omni frames ([`method1`]) and the closed loop's own logged
 //! tracker output ([`closed_loop`]); a real laser log goes through [`real`] instead.
-//! Aggregation ([`aggregate`]): Table I and the rst events ([`table1`]), the methods and the
-//! t-tests ([`compare`]), method 1's loss rate, the real log, the figures ([`figures`]).
+//! Aggregation ([`aggregate`]): Table I, "followed" and the rst events ([`table1`]), the
+//! methods, their re-acquisitions and the Holm-corrected t-tests ([`compare`]), the colour
+//! descriptor's separation of target and clutter ([`colour`]), method 1's loss rate, the real
+//! log, the figures ([`figures`]).
 
 mod aggregate;
 mod closed_loop;
+mod colour;
 mod compare;
 mod figures;
 mod method1;
@@ -38,7 +41,7 @@ pub struct KobilarovFollowing;
 
 impl Experiment for KobilarovFollowing {
     const KIND: &'static str = "s001_kobilarov_following";
-    const VERSION: u32 = 1;
+    const VERSION: u32 = 2;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

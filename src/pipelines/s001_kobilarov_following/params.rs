@@ -54,6 +54,12 @@ pub struct Params {
     pub lock_m: f64,
     /// Window after an occlusion over which the models' errors are compared (s).
     pub after_occlusion_s: f64,
+    /// "Followed" (decided before the full run): the robot's own estimate within
+    /// `followed_within_m` of the true person on at least `followed_share` of the run's scans,
+    /// and the robot within `followed_end_m` of the person at the run's end.
+    pub followed_within_m: f64,
+    pub followed_share: f64,
+    pub followed_end_m: f64,
     /// Occlusions shorter than this are not events (s).
     pub min_occlusion_s: f64,
     /// Method 1: lost when the bearing is farther than this from the truth (deg), and the
@@ -84,7 +90,7 @@ impl Default for Params {
             base_frame: "base_link".into(),
             imu_topic: "/imu".into(),
             gt_tolerance_s: 0.06,
-            following_distance_m: 1.8,
+            following_distance_m: 3.2,
             max_decel_mps2: 1.4,
             methods: METHODS.iter().map(|m| (*m).to_string()).collect(),
             follower: FollowSpec::default(),
@@ -92,6 +98,9 @@ impl Default for Params {
             occlusion_margin_m: 0.1,
             lock_m: 0.5,
             after_occlusion_s: 2.0,
+            followed_within_m: 1.0,
+            followed_share: 0.95,
+            followed_end_m: 6.0,
             min_occlusion_s: 0.3,
             method1_lost_deg: 15.0,
             method1_speed_bin: 0.5,
@@ -116,6 +125,8 @@ pub enum Method {
         /// The colour template follows the target (`template_update` per scan) instead of
         /// staying as taken at initialisation.
         update: bool,
+        /// corr as printed (no square root) instead of the normalised form.
+        printed: bool,
     },
     /// The laser issue's multi-person tracker (`laser::tracker`), its track nearest the
     /// target followed.
@@ -126,13 +137,24 @@ pub enum Method {
 pub const PAPER: &str = "ct_colour";
 /// The same with the template updated while tracking (the paper allows both).
 pub const UPDATED: &str = "ct_colour_updated";
+/// The same with corr as printed (Σ H_i H_j / (Σ H_i² Σ H_j²), no square root).
+pub const PRINTED: &str = "ct_colour_printed";
 pub const CV: &str = "cv_colour";
 pub const IMM: &str = "imm_colour";
 pub const NO_COLOUR: &str = "ct_no_colour";
 pub const NN: &str = "nn_ct";
 pub const LASER_TRACKER: &str = "laser_tracker";
 /// Every known method, in the default table order.
-pub const METHODS: [&str; 7] = [PAPER, UPDATED, CV, IMM, NO_COLOUR, NN, LASER_TRACKER];
+pub const METHODS: [&str; 8] = [
+    PAPER,
+    UPDATED,
+    PRINTED,
+    CV,
+    IMM,
+    NO_COLOUR,
+    NN,
+    LASER_TRACKER,
+];
 
 /// The method a name stands for.
 pub fn method(name: &str) -> Option<Method> {
@@ -144,11 +166,19 @@ pub fn method(name: &str) -> Option<Method> {
             association,
             colour,
             update,
+            printed: false,
         })
     };
     match name {
         PAPER => f(Ct, Pdaf, true, false),
         UPDATED => f(Ct, Pdaf, true, true),
+        PRINTED => Some(Method::Follower {
+            model: Ct,
+            association: Pdaf,
+            colour: true,
+            update: false,
+            printed: true,
+        }),
         CV => f(Cv, Pdaf, true, false),
         IMM => f(Imm, Pdaf, true, false),
         NO_COLOUR => f(Ct, Pdaf, false, false),
@@ -173,6 +203,8 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
         ("max_decel_mps2", p.max_decel_mps2),
         ("lock_m", p.lock_m),
         ("after_occlusion_s", p.after_occlusion_s),
+        ("followed_within_m", p.followed_within_m),
+        ("followed_end_m", p.followed_end_m),
         ("method1_lost_deg", p.method1_lost_deg),
         ("method1_speed_bin", p.method1_speed_bin),
         ("fig7_window_s", p.fig7_window_s),
@@ -194,6 +226,12 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
         out.push((
             "template_update".into(),
             format!("{} is not in (0, 1]", p.template_update),
+        ));
+    }
+    if !(p.followed_share > 0.0 && p.followed_share <= 1.0) {
+        out.push((
+            "followed_share".into(),
+            format!("{} is not in (0, 1]", p.followed_share),
         ));
     }
     if !(p.level > 0.0 && p.level < 1.0) {

@@ -32,6 +32,7 @@ pub fn methods(p: &Params) -> Vec<(String, Method)> {
                 association,
                 colour: false,
                 update: false,
+                printed: false,
             },
             other => other,
         };
@@ -118,6 +119,7 @@ pub(super) fn process(
     out.insert(tables::LOOP.into(), tables::LoopRow::frame(&[])?);
     out.insert(tables::METHOD1.into(), tables::Method1Row::frame(&[])?);
     out.insert(tables::REAL.into(), RealRow::frame(&rows)?);
+    out.insert(tables::COLOUR.into(), tables::ColourRow::frame(&[])?);
     Ok(out)
 }
 

@@ -35,10 +35,14 @@ impl Runner {
                 association,
                 colour,
                 update,
+                printed,
             } => {
                 let mut fp = p.follower.params(model, association, colour);
                 if update {
                     fp.template_update = p.template_update;
+                }
+                if printed {
+                    fp.corr_form = crate::vision::cylinder::CorrForm::Printed;
                 }
                 Runner::Follower(Box::new(FollowTracker::new(&fp, init)))
             }
@@ -83,16 +87,7 @@ impl LaserSelect {
             .filter_map(|&i| d.legs.get(i).map(|l| l.fixed))
             .collect();
         self.tracker.step(t, &people, &single);
-        let mut out = StepOutput {
-            estimate: None,
-            reset: false,
-            initialised: false,
-            blobs: people.len(),
-            gated: 0,
-            beta0: None,
-            chosen: None,
-            chosen_lr: None,
-        };
+        let mut out = StepOutput::empty(people.len());
         let current = self
             .id
             .and_then(|id| self.tracker.confirmed().find(|tr| tr.id == id));

@@ -18,7 +18,7 @@ use nalgebra::{Isometry3, Point3};
 use super::params::{self, Params};
 use super::pose::{self, Tilt};
 use super::replay::{self, Runner};
-use super::tables::{self, Method1Row, TrackRow, TruthRow};
+use super::tables::{self, ColourRow, Method1Row, TrackRow, TruthRow};
 use super::{closed_loop, method1, real, scene};
 use crate::frames::camera as camera_frames;
 use crate::frames::laser::{self as laser_frames, LaserFrame, LaserOptions};
@@ -126,7 +126,7 @@ fn synthetic(s: &Session, p: &Params, bar: &dyn Progress) -> anyhow::Result<Sess
         tolerance_ns: (p.gt_tolerance_s * 1e9).round() as u64,
     };
     bar.set_message("replaying the trackers");
-    let (tracks, truth_rows, m1) = replay_all(&mut ctx, bar)?;
+    let (tracks, truth_rows, m1, colour) = replay_all(&mut ctx, bar)?;
     let loop_rows = closed_loop::rows(&ctx.tf, log, &p.follower_topic, ctx.t0)?;
     let mut out = SessionTables::new();
     out.insert(tables::TRACKS.into(), TrackRow::frame(&tracks)?);
@@ -134,6 +134,7 @@ fn synthetic(s: &Session, p: &Params, bar: &dyn Progress) -> anyhow::Result<Sess
     out.insert(tables::LOOP.into(), tables::LoopRow::frame(&loop_rows)?);
     out.insert(tables::METHOD1.into(), Method1Row::frame(&m1)?);
     out.insert(tables::REAL.into(), tables::RealRow::frame(&[])?);
+    out.insert(tables::COLOUR.into(), ColourRow::frame(&colour)?);
     Ok(out)
 }
 
@@ -175,7 +176,12 @@ impl Omni<'_> {
     }
 }
 
-type Replayed = (Vec<TrackRow>, Vec<TruthRow>, Vec<Method1Row>);
+type Replayed = (
+    Vec<TrackRow>,
+    Vec<TruthRow>,
+    Vec<Method1Row>,
+    Vec<ColourRow>,
+);
 
 /// The one pass over scans and omni frames (see the module doc).
 fn replay_all(ctx: &mut Ctx<'_>, bar: &dyn Progress) -> anyhow::Result<Replayed> {
@@ -205,6 +211,7 @@ fn replay_all(ctx: &mut Ctx<'_>, bar: &dyn Progress) -> anyhow::Result<Replayed>
     };
     let mut runners: Vec<(String, Runner)> = Vec::new();
     let (mut tracks, mut truth_rows, mut m1_rows) = (Vec::new(), Vec::new(), Vec::new());
+    let mut colour = Vec::new();
     let mut prev_robot: Option<(f64, f64, f64)> = None;
     for (idx, f) in laser_frames::scans(log, &p.scan_topic, &options)?.enumerate() {
         let f = f?;
@@ -236,21 +243,15 @@ fn replay_all(ctx: &mut Ctx<'_>, bar: &dyn Progress) -> anyhow::Result<Replayed>
             }
         }
         let truth_row = truth_at(ctx, &f, idx as i64, t, &mut prev_robot);
-        tracks.extend(step_all(
-            ctx,
-            &mut runners,
-            &omni,
-            &f,
-            &pose,
-            idx as i64,
-            t,
-        )?);
+        let (rows, blobs) = step_all(ctx, &mut runners, &omni, &f, &pose, idx as i64, t)?;
+        tracks.extend(rows);
+        colour.extend(blobs);
         truth_rows.extend(truth_row);
         if idx % 50 == 0 {
             bar.set_message(&format!("scan {idx}"));
         }
     }
-    Ok((tracks, truth_rows, m1_rows))
+    Ok((tracks, truth_rows, m1_rows, colour))
 }
 
 /// The target's first true position moved into the fixed frame: where the robot's operator
@@ -263,7 +264,8 @@ fn initial_point(ctx: &Ctx<'_>, at: Nanos) -> Option<[f64; 2]> {
     Some([q.x, q.y])
 }
 
-/// Every method on one scan, their estimates in `map` and scored against the truth.
+/// Every method on one scan, their estimates in `map` and scored against the truth; the
+/// paper configuration's blobs with their colour correlation and what they are.
 fn step_all(
     ctx: &Ctx<'_>,
     runners: &mut [(String, Runner)],
@@ -272,7 +274,7 @@ fn step_all(
     pose: &Isometry3<f64>,
     idx: i64,
     t: f64,
-) -> anyhow::Result<Vec<TrackRow>> {
+) -> anyhow::Result<(Vec<TrackRow>, Vec<ColourRow>)> {
     let g = ScanGeometry::of(&f.scan);
     let pts = points::project(&f.scan.ranges, &g, Some(pose));
     let camera_from_fixed = omni
@@ -283,6 +285,7 @@ fn step_all(
     let map_from_fixed = ctx.tf.lookup("map", &ctx.p.fixed_frame, f.stamp).ok();
     let people = ctx.gt.nearest(f.stamp, ctx.tolerance_ns);
     let mut rows = Vec::with_capacity(runners.len());
+    let mut colour = Vec::new();
     for (name, r) in runners.iter_mut() {
         let obs = ScanObs {
             t,
@@ -296,6 +299,18 @@ fn step_all(
         let out = r
             .step(&obs, f.scan.ranges.len(), Some(pose))
             .with_context(|| format!("{}: {name} at scan {idx}", ctx.log.path().display()))?;
+        if name == params::PAPER
+            && let (Some(m), Some(frame)) = (map_from_fixed.as_ref(), people)
+        {
+            colour.extend(out.blob_corr.iter().map(|(c, corr)| {
+                let q = m * Point3::new(c[0], c[1], 0.0);
+                ColourRow {
+                    scan_idx: idx,
+                    kind: blob_kind(frame, (q.x, q.y), ctx.p).into(),
+                    corr: *corr,
+                }
+            }));
+        }
         rows.push(track_row(
             ctx,
             name,
@@ -306,7 +321,23 @@ fn step_all(
             people,
         ));
     }
-    Ok(rows)
+    Ok((rows, colour))
+}
+
+/// What a blob at `at` (map) is: the target, another person (within `lock_m` of their true
+/// position) or something static.
+fn blob_kind(frame: &PeopleFrame, at: (f64, f64), p: &Params) -> &'static str {
+    let near = frame
+        .people
+        .iter()
+        .map(|q| (q.id, (q.x - at.0).hypot(q.y - at.1)))
+        .filter(|(_, d)| *d <= p.lock_m)
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    match near {
+        Some((id, _)) if id == p.target_id => "target",
+        Some(_) => "person",
+        None => "static",
+    }
 }
 
 fn track_row(
@@ -348,6 +379,7 @@ fn track_row(
         gated: out.gated as i64,
         beta0: out.beta0,
         lr: out.chosen_lr,
+        corr: out.chosen_corr,
         target_err_m: target_err,
         nearest_id: nearest.map(|n| n.0),
         nearest_m: nearest.map(|n| n.1),

@@ -57,6 +57,12 @@ table_row! {
         pub v_avg: Option<f64>,
         pub err_avg: Option<f64>,
         pub v_max: Option<f64>,
+        /// Share of the run's scans on which the robot's own estimate lay within
+        /// `followed_within_m` of the person, the robot's range to them at the end, and
+        /// whether the run counts as followed (see [`followed`]).
+        pub on_person: Option<f64>,
+        pub end_range_m: Option<f64>,
+        pub followed: Option<String>,
     }
 }
 
@@ -92,6 +98,34 @@ table_row! {
     }
 }
 
+/// "Followed" (fixed before the full run): the robot's own logged estimate lies within
+/// `followed_within_m` of the true person on at least `followed_share` of the run's scans (a
+/// scan without an estimate counts against it), and the robot ends within `followed_end_m` of
+/// the person. Returns (share, range at the end, followed).
+pub fn followed(d: &SessionData, p: &Params) -> Option<(f64, f64, bool)> {
+    let truth: Vec<&TruthRow> = d.truth.iter().filter(|r| r.target_x.is_some()).collect();
+    let end = truth.last()?.range_m?;
+    let near = |t: f64| {
+        d.closed_loop
+            .iter()
+            .min_by(|a, b| (a.t_s - t).abs().total_cmp(&(b.t_s - t).abs()))
+            .filter(|l| (l.t_s - t).abs() < 0.05)
+    };
+    let on = truth
+        .iter()
+        .filter(|r| {
+            near(r.t_s).is_some_and(|l| match (l.x, l.y, r.target_x, r.target_y) {
+                (Some(x), Some(y), Some(tx), Some(ty)) => {
+                    (x - tx).hypot(y - ty) <= p.followed_within_m
+                }
+                _ => false,
+            })
+        })
+        .count() as f64
+        / truth.len() as f64;
+    Some((on, end, on >= p.followed_share && end <= p.followed_end_m))
+}
+
 /// Table I's five values of one run.
 pub fn run_values(truth: &[TruthRow], p: &Params) -> Option<[f64; 5]> {
     let rows: Vec<&TruthRow> = truth.iter().filter(|r| r.range_m.is_some()).collect();
@@ -122,6 +156,9 @@ fn row(
     v: Option<[f64; 5]>,
 ) -> Table1Row {
     Table1Row {
+        on_person: None,
+        end_range_m: None,
+        followed: None,
         source: source.into(),
         run: run.into(),
         controller: controller.into(),
@@ -143,8 +180,18 @@ pub fn table1_rows(data: &[&SessionData], p: &Params) -> Vec<Table1Row> {
         values.extend(v);
         let controller = d.closed_loop.first().map_or("", |r| r.controller.as_str());
         let dur = d.truth.last().map(|r| r.t_s);
-        out.push(row("ours", &d.name, controller, dur, v));
+        let f = followed(d, p);
+        out.push(Table1Row {
+            on_person: f.map(|f| f.0),
+            end_range_m: f.map(|f| f.1),
+            followed: f.map(|f| if f.2 { "yes" } else { "no" }.to_string()),
+            ..row("ours", &d.name, controller, dur, v)
+        });
     }
+    let n_followed = out
+        .iter()
+        .filter(|r| r.followed.as_deref() == Some("yes"))
+        .count();
     let col = |i: usize| values.iter().map(|v| v[i]).collect::<Vec<f64>>();
     let summaries: Vec<Option<stats::Summary>> =
         (0..5).map(|i| stats::describe(&col(i)).ok()).collect();
@@ -154,10 +201,16 @@ pub fn table1_rows(data: &[&SessionData], p: &Params) -> Vec<Table1Row> {
             .all(Option::is_some)
             .then(|| [0, 1, 2, 3, 4].map(|i| v[i].unwrap_or(f64::NAN)))
     };
-    out.push(row("ours", "mean", "", None, pick(|s| s.mean)));
+    out.push(Table1Row {
+        followed: Some(format!("{n_followed} of {}", data.len())),
+        ..row("ours", "mean", "", None, pick(|s| s.mean))
+    });
     out.push(row("ours", "std", "", None, pick(|s| s.std)));
     for (i, v) in PAPER_TABLE_I.iter().enumerate() {
-        out.push(row("paper", &format!("run {}", i + 1), "", None, Some(*v)));
+        out.push(Table1Row {
+            followed: Some("yes".into()),
+            ..row("paper", &format!("run {}", i + 1), "", None, Some(*v))
+        });
     }
     out.push(row("paper", "mean", "", None, Some(PAPER_MEAN)));
     out.push(row("paper", "std", "", None, Some(PAPER_STD)));
@@ -249,12 +302,25 @@ pub fn tables(data: &[&SessionData], p: &Params) -> anyhow::Result<Vec<Table>> {
         "Table I: averaged estimates per run (r range, b |bearing|, v robot speed, err |E_follow|, v_max), ours beside the paper's",
         super::table1::Table1Row::frame(&table1_rows(data, p))?,
     );
-    for c in ["duration_s", "r_avg", "b_avg", "v_avg", "err_avg", "v_max"] {
+    for c in [
+        "duration_s",
+        "r_avg",
+        "b_avg",
+        "v_avg",
+        "err_avg",
+        "v_max",
+        "on_person",
+        "end_range_m",
+    ] {
         t1 = t1.with_precision(c, 2);
     }
     let t1 = t1.with_note(format!(
-        "Ours: the closed loop's ground truth at every scan where the person exists (robot pose map <- base_link, exact in the synthesizer). E_follow = r - d_follow - v^2/(2 a_min) with d_follow = {} m, a_min = {} m/s^2 (the controller's settings). b in rad. Paper: 12 runs of 2-3 min in a park, Segway RMP.",
-        p.following_distance_m, p.max_decel_mps2
+        "Ours: the closed loop's ground truth at every scan where the person exists (robot pose map <- base_link, exact in the synthesizer). E_follow = r - d_follow - v^2/(2 a_min) with d_follow = {} m, a_min = {} m/s^2 (the controller's settings). b in rad. Followed: the robot's own estimate within {} m of the person on at least {} of the scans (on_person) and the robot within {} m of the person at the end (end_range_m). Paper: 12 runs of 2-3 min in a park, Segway RMP, all followed.",
+        p.following_distance_m,
+        p.max_decel_mps2,
+        p.followed_within_m,
+        p.followed_share,
+        p.followed_end_m
     ));
     let ev: Vec<RstRow> = data.iter().flat_map(|d| events(d, p)).collect();
     let mut te = Table::new(
@@ -306,8 +372,9 @@ pub fn summary(data: &[&SessionData], p: &Params) -> Vec<String> {
             (m.r_avg, m.b_avg, m.v_avg, m.err_avg, m.v_max)
     {
         out.push(format!(
-            "Table I over {} runs: r_avg {r:.2} m, b_avg {b:.2} rad, v_avg {v:.2} m/s, err_avg {e:.2} m, v_max {x:.2} m/s (paper: 4.04, 0.15, 1.50, 0.30, 2.06)",
-            data.len()
+            "Table I over {} runs: r_avg {r:.2} m, b_avg {b:.2} rad, v_avg {v:.2} m/s, err_avg {e:.2} m, v_max {x:.2} m/s (paper: 4.04, 0.15, 1.50, 0.30, 2.06); followed: {} (paper: 12 of 12)",
+            data.len(),
+            m.followed.as_deref().unwrap_or("-")
         ));
     }
     let ev: Vec<RstRow> = data.iter().flat_map(|d| events(d, p)).collect();

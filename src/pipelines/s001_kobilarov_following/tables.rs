@@ -12,6 +12,7 @@ pub const TRUTH: &str = "truth";
 pub const LOOP: &str = "closed_loop";
 pub const METHOD1: &str = "method1";
 pub const REAL: &str = "real";
+pub const COLOUR: &str = "colour";
 
 table_row! {
     /// One replayed method on one scan: its estimate in the evaluation frame (`map` on
@@ -32,6 +33,8 @@ table_row! {
         pub gated: i64,
         pub beta0: Option<f64>,
         pub lr: Option<f64>,
+        /// The chosen blob's normalised correlation with the template.
+        pub corr: Option<f64>,
         /// Distance to the target's true position (m), when both exist.
         pub target_err_m: Option<f64>,
         /// The person nearest the estimate (ground-truth id) and the distance to them.
@@ -105,6 +108,18 @@ table_row! {
 }
 
 table_row! {
+    /// One blob of one scan as the paper's configuration saw it: its normalised correlation
+    /// with the template and what the ground truth says it is (`target`, `person` — another
+    /// person — or `static`: nobody within `lock_m`): `colour`.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct ColourRow {
+        pub scan_idx: i64,
+        pub kind: String,
+        pub corr: f64,
+    }
+}
+
+table_row! {
     /// A real laser log: one method on one annotated scan (laser frame): `real`.
     #[derive(Debug, Clone, PartialEq)]
     pub struct RealRow {
@@ -135,6 +150,7 @@ pub struct SessionData {
     pub closed_loop: Vec<LoopRow>,
     pub method1: Vec<Method1Row>,
     pub real: Vec<RealRow>,
+    pub colour: Vec<ColourRow>,
 }
 
 impl SessionData {
@@ -161,6 +177,7 @@ pub fn load(ctx: &Aggregate) -> anyhow::Result<Vec<SessionData>> {
                 closed_loop: read(t, LOOP, &name)?,
                 method1: read(t, METHOD1, &name)?,
                 real: read(t, REAL, &name)?,
+                colour: read(t, COLOUR, &name)?,
                 name,
             })
         })

@@ -244,7 +244,7 @@ fn command(
     }
     let Some(est) = &output.estimate else {
         trail.clear();
-        return controller::stop(robot, lim);
+        return controller::stop(robot, output.look_at, lim);
     };
     trail.push(est.position);
     trail.advance(robot.x, robot.y);

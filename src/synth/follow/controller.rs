@@ -13,7 +13,9 @@
 //! speed, `a_min` its largest deceleration: the term seed 001's `E_follow` subtracts, so the
 //! robot can always stop short of the person), and the speed and turn-rate limits. The loop
 //! applies the acceleration and deceleration limits when it tracks the commanded speed;
-//! without an estimate the command is a stop, which it reaches at `a_min`.
+//! without an estimate the command is a stop, which it reaches at `a_min`, turning towards the
+//! target's last prediction when the follower gives one ([`stop`]; seed 001 §VI: `rst` "will
+//! cause the robot to stop, and reinitiate the track").
 
 use super::Estimate;
 use crate::synth::robot::wrap;
@@ -84,11 +86,17 @@ fn heading_factor(bearing: f64) -> f64 {
     1.0 - 0.6 * bearing.abs().min(1.0)
 }
 
-/// Stop: the loop decelerates at `a_min` to a standstill.
-pub fn stop(robot: &OdomPose, lim: &Limits) -> Command {
+/// Stop: the loop decelerates at `a_min` to a standstill; with `look_at` (the target's last
+/// prediction, `odom`) the robot turns towards it (`ω = K_β·β`, turn-rate limited), so the
+/// laser's 180° keeps the place the target was lost in view while the follower looks for it.
+pub fn stop(robot: &OdomPose, look_at: Option<[f64; 2]>, lim: &Limits) -> Command {
+    let w = look_at.map_or(0.0, |p| {
+        let bearing = wrap((p[1] - robot.y).atan2(p[0] - robot.x) - robot.yaw);
+        (K_BEARING * bearing).clamp(-lim.max_turn_rate, lim.max_turn_rate)
+    });
     Command {
         v: 0.0,
-        w: 0.0,
+        w,
         desired_distance: lim.desired_distance(robot.v),
     }
 }

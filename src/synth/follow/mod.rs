@@ -81,6 +81,9 @@ pub struct FollowerOutput {
     pub estimate: Option<Estimate>,
     /// `rst` fired at this scan (the track was dropped to be re-initialised).
     pub reset: bool,
+    /// While lost: where the target was last predicted (`odom`); the robot stops and turns
+    /// towards it. `None`: stop without turning.
+    pub look_at: Option<[f64; 2]>,
 }
 
 /// A target estimator fed scan by scan, in time order.

@@ -141,6 +141,7 @@ impl Follower for NearestBlobFollower {
                 return FollowerOutput {
                     estimate: None,
                     reset: false,
+                    look_at: None,
                 };
             };
             let tr = TrackState {
@@ -154,6 +155,7 @@ impl Follower for NearestBlobFollower {
             return FollowerOutput {
                 estimate: Some(e),
                 reset: false,
+                look_at: None,
             };
         };
         let dt = (t - tr.t_last).max(0.0);
@@ -176,6 +178,7 @@ impl Follower for NearestBlobFollower {
                 return FollowerOutput {
                     estimate: None,
                     reset: true,
+                    look_at: None,
                 };
             }
             None => tr.position = predicted,
@@ -184,6 +187,7 @@ impl Follower for NearestBlobFollower {
         FollowerOutput {
             estimate: Some(estimate(tr, t)),
             reset: false,
+            look_at: None,
         }
     }
 

@@ -49,12 +49,14 @@ impl Follower for PdafFollower {
                     covariance: e.covariance,
                 }),
                 reset: out.reset,
+                look_at: out.look_at,
             },
             Err(_) => {
                 self.tracker.drop_track(input.t);
                 FollowerOutput {
                     estimate: None,
                     reset: true,
+                    look_at: None,
                 }
             }
         }

@@ -357,9 +357,11 @@ fn the_closed_loop_follows_a_walker_with_both_controllers() {
     }
 }
 
-/// Sees the target straight ahead 3 m away until `lost_at`, then nothing.
+/// Sees the target straight ahead 3 m away until `lost_at`, then nothing; with `look`, it
+/// then gives that point (`odom`) as the target's last prediction.
 struct LosesAt {
     lost_at: f64,
+    look: Option<[f64; 2]>,
 }
 
 impl Follower for LosesAt {
@@ -369,6 +371,7 @@ impl Follower for LosesAt {
         FollowerOutput {
             estimate: seen.then(|| still(ahead.x, ahead.y)),
             reset: (input.t - self.lost_at).abs() < 0.05,
+            look_at: if seen { None } else { self.look },
         }
     }
 }
@@ -376,7 +379,13 @@ impl Follower for LosesAt {
 #[test]
 fn a_lost_target_stops_the_robot_at_its_deceleration_limit() {
     let lost_at = 5.0;
-    let run = run_disc_world(Controller::Direct, &mut LosesAt { lost_at });
+    let run = run_disc_world(
+        Controller::Direct,
+        &mut LosesAt {
+            lost_at,
+            look: None,
+        },
+    );
     let first_none = run
         .scans
         .iter()
@@ -398,4 +407,38 @@ fn a_lost_target_stops_the_robot_at_its_deceleration_limit() {
         .map(|s| s.pitch)
         .fold(0.0, f64::min);
     assert!(min_pitch.to_degrees() < -3.0, "{}", min_pitch.to_degrees());
+    // without a last prediction it does not turn
+    assert!(
+        run.scans
+            .iter()
+            .filter(|s| s.t > lost_at)
+            .all(|s| s.command.w == 0.0)
+    );
+}
+
+/// Lost with a last prediction to its left: the robot stops and turns in place until it
+/// faces that point (yaw = its bearing), at most at the turn-rate limit.
+#[test]
+fn a_lost_target_turns_the_stopped_robot_towards_its_last_prediction() {
+    let lost_at = 3.0;
+    // the robot starts at the origin heading +x (`robot_spec`); look far to its left
+    let run = run_disc_world(
+        Controller::Direct,
+        &mut LosesAt {
+            lost_at,
+            look: Some([0.0, 40.0]),
+        },
+    );
+    let end = run.track.samples.last().expect("samples");
+    assert_eq!(end.v, 0.0);
+    let bearing = (40.0 - end.y).atan2(-end.x);
+    let err = crate::synth::robot::wrap(bearing - end.yaw);
+    assert!(err.abs() < 0.05, "still {err} rad off the last prediction");
+    let lim = limits();
+    assert!(
+        run.scans
+            .iter()
+            .all(|s| s.command.w.abs() <= lim.max_turn_rate)
+    );
+    assert!(run.scans.iter().any(|s| s.t > lost_at && s.command.w > 0.5));
 }

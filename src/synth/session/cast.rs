@@ -8,7 +8,7 @@ use rand::RngExt;
 
 use super::types::{Actor, SynthError};
 use crate::rng;
-use crate::synth::motion::{self, Goal, Track};
+use crate::synth::motion::{self, Goal, Track, jog};
 use crate::synth::person::Body;
 use crate::synth::robot::{self, RobotTrack};
 use crate::synth::scenario::{Motion, PersonSpec, Scenario};
@@ -193,6 +193,35 @@ fn scripted_track(
             let first = start.unwrap_or((from.0, from.1, 0.0));
             Ok(motion::walk(first, &goals, p.enter_s, leave, &mut r))
         }
+        Motion::Jog {
+            area,
+            speed,
+            stretch_m,
+            max_turn_deg,
+            lateral_accel,
+            accel,
+            clearance_m,
+            start,
+            heading_deg,
+        } => {
+            let spec = jog::RouteSpec {
+                area: *area,
+                speed: *speed,
+                stretch_m: *stretch_m,
+                max_turn_deg: *max_turn_deg,
+                clearance_m: *clearance_m,
+            };
+            let pace = (*lateral_accel, *accel);
+            let at = (*start, *heading_deg);
+            Ok(jog_track(
+                &spec,
+                pace,
+                at,
+                (p.enter_s, leave),
+                world,
+                &mut r,
+            ))
+        }
         Motion::Replay {
             file,
             track,
@@ -209,6 +238,38 @@ fn scripted_track(
         }
     }
 }
+
+/// A `jog` motion's track (`synth::motion::jog`): its route from `at` (start, heading in
+/// degrees; random when absent), then running it with `pace` (lateral acceleration, pace
+/// change) between `span` (enter, leave).
+fn jog_track(
+    spec: &jog::RouteSpec,
+    pace: (f64, f64),
+    at: (Option<[f64; 2]>, Option<f64>),
+    span: (f64, f64),
+    world: &World,
+    r: &mut rand_chacha::ChaCha8Rng,
+) -> Track {
+    let area = spec.area;
+    let random = (
+        area[0] + r.random::<f64>() * (area[2] - area[0]),
+        area[1] + r.random::<f64>() * (area[3] - area[1]),
+        r.random::<f64>() * std::f64::consts::TAU,
+    );
+    let from = (
+        at.0.map_or(random.0, |p| p[0]),
+        at.0.map_or(random.1, |p| p[1]),
+        at.1.map_or(random.2, f64::to_radians),
+    );
+    let dur = span.1 - span.0 + 10.0;
+    let route = jog::route((from.0, from.1), from.2, spec, dur, &world.obstacles, r);
+    jog::run(from, &route.goals, pace.0, pace.1, span, r)
+}
+
+/// A companion runs this far beside the target (m): shoulder to shoulder with a step between.
+const COMPANION_OFFSET_M: f64 = 1.0;
+/// ... and crosses this far behind it (m), between the following robot and the target.
+const COMPANION_BEHIND_M: f64 = 0.8;
 
 /// The crowd's ids follow the scripted people's, so every person of a session has their own
 /// id (ground truth and the rendered id buffer are keyed by it).
@@ -269,6 +330,22 @@ fn actors(
                     .ok_or_else(|| {
                         SynthError::Scenario("crowd.cross_between_robot_and names no person".into())
                     })?;
+                if k < c.companions {
+                    // run beside the target, then cross behind it (between robot and target)
+                    let company = jog::Company {
+                        side: if r.random::<bool>() { 1.0 } else { -1.0 },
+                        offset_m: COMPANION_OFFSET_M,
+                        behind_m: COMPANION_BEHIND_M,
+                        join_s: 2.0,
+                        cross_at_s: 0.5 * stay,
+                        cross_s: 2.0,
+                    };
+                    out.push(Actor {
+                        body,
+                        track: jog::companion(target, &company, enter, leave),
+                    });
+                    continue;
+                }
                 let tc = enter + stay / 2.0;
                 let rs = robot.state(tc);
                 let tp = target.position(tc).unwrap_or((rs.x + 2.0, rs.y));

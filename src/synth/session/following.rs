@@ -198,6 +198,7 @@ pub(super) fn write_states(
                 command_w: rec.command.w,
                 desired_distance: rec.command.desired_distance,
                 robot: rec.robot,
+                look_at: rec.output.look_at,
             },
         )?;
     }
