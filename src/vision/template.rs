@@ -33,8 +33,9 @@
 //! here. The minimum error over templates at each position is the maximum score; its local
 //! extrema are kept by greedy non-maximum suppression in the image (a candidate survives if
 //! its box overlaps no better one by more than `nms_iou` and lies no more than
-//! `nms_contained` inside one — a smaller template nested in a larger one has a small IoU),
-//! the paper's non-minimal suppression. Placements may hang over the image border (at least `min_inside` of the
+//! `nms_contained` inside one — a smaller template nested in a larger one has a small IoU,
+//! [`Suppression::Boxes`]), or as local maxima of the score image around a better detection's
+//! head ([`Suppression::Heads`]): the paper's non-minimal suppression. Placements may hang over the image border (at least `min_inside` of the
 //! window inside, the head row inside); only the inside part is compared. A placement whose
 //! score cannot reach the threshold (bound `1 − |Σ T − Σ S| / A` from the window sum) is
 //! skipped without correlating.
@@ -44,8 +45,15 @@
 //! human template", §4), the template's body width and height, and the centroid of the
 //! foreground pixels inside the box (the blob centroid the paper compares against, §5).
 //!
-//! What it does not do: no learned shapes, no per-position template choice (the whole set is
-//! tried everywhere), no sub-pixel positions (the search stride is a parameter).
+//! [`Probe`] (in `probe`) measures what the detector could have found near a known head point
+//! (the chain's error analysis).
+//!
+//! What it does not do: no learned shapes, no sub-pixel positions (the search stride is a
+//! parameter).
+
+mod probe;
+
+pub use probe::{Fill, Fit, Probe};
 
 use crate::geometry::rect::{contained, iou};
 use nalgebra::Point3;
@@ -172,6 +180,79 @@ impl Silhouette {
                 self.body[2] + pad_x,
                 self.body[3] + pad_y,
             ],
+        }
+    }
+
+    /// The same profile `factor` times as wide: every row's run scaled about its centre (the
+    /// lean line stays where it was), for people whose arms and clothes make them wider than
+    /// the profile's torso. Apply before [`Silhouette::grown`] and [`Silhouette::padded`].
+    pub fn widened(self, factor: f64) -> Silhouette {
+        if !(factor > 0.0) || factor == 1.0 || self.spans.is_empty() {
+            return self;
+        }
+        let raw: Vec<(i64, i64)> = self
+            .spans
+            .iter()
+            .map(|&(a, b)| {
+                let c = 0.5 * f64::from(a + b);
+                let half = 0.5 * f64::from(b - a) * factor;
+                let (na, nb) = ((c - half).round() as i64, (c + half).round() as i64);
+                (na, nb.max(na + 1))
+            })
+            .collect();
+        let min_a = raw.iter().map(|s| s.0).min().unwrap_or(0);
+        let max_b = raw.iter().map(|s| s.1).max().unwrap_or(1);
+        let spans: Vec<(u32, u32)> = raw
+            .iter()
+            .map(|&(a, b)| ((a - min_a) as u32, (b - min_a) as u32))
+            .collect();
+        let width = (max_b - min_a).max(1) as u32;
+        Silhouette {
+            width,
+            height: self.height,
+            area: spans.iter().map(|(a, b)| b - a).sum(),
+            head: (self.head.0 - min_a as f64, self.head.1),
+            body_width_px: spans.iter().map(|(a, b)| b - a).max().unwrap_or(1) as f64,
+            spans,
+            tilt_rad: self.tilt_rad,
+            body: [0, 0, width, self.height],
+        }
+    }
+
+    /// The silhouette as the segmentation shows it: dilated by a `(2 px + 1)²` square (each
+    /// row's run becomes the union of the runs within `px` rows, widened by `px` each side),
+    /// since a filter bank of envelope σ spreads the foreground of an edge by about σ. The
+    /// person's own box ([`Silhouette::body`]), head point and body width stay those of the
+    /// undilated silhouette, `px` inside the grown shape, so detections report the person.
+    /// Apply before [`Silhouette::padded`].
+    pub fn grown(self, px: u32) -> Silhouette {
+        if px == 0 || self.spans.is_empty() {
+            return self;
+        }
+        let g = px as usize;
+        let n = self.spans.len();
+        let spans: Vec<(u32, u32)> = (0..n + 2 * g)
+            .map(|r| {
+                // old rows r − 2g ..= r (in old coordinates: the new row r is old row r − g)
+                let lo = r.saturating_sub(2 * g);
+                let hi = r.min(n - 1);
+                let (a, b) = self.spans[lo..=hi]
+                    .iter()
+                    .filter(|s| s.1 > s.0)
+                    .fold((u32::MAX, 0), |(a, b), s| (a.min(s.0), b.max(s.1)));
+                if a >= b { (0, 0) } else { (a, b + 2 * px) }
+            })
+            .collect();
+        let area = spans.iter().map(|(a, b)| b - a).sum();
+        Silhouette {
+            width: self.width + 2 * px,
+            height: self.height + 2 * px,
+            spans,
+            area,
+            head: (self.head.0 + f64::from(px), self.head.1 + f64::from(px)),
+            body_width_px: self.body_width_px,
+            tilt_rad: self.tilt_rad,
+            body: self.body.map(|v| v + px),
         }
     }
 
@@ -386,6 +467,20 @@ pub fn expected_appearance(
     })
 }
 
+/// How overlapping candidates are suppressed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Suppression {
+    /// Greedy box suppression: a candidate is dropped when its box overlaps a better
+    /// detection by more than `nms_iou` or lies more than `nms_contained` inside one.
+    Boxes,
+    /// Local maxima of the combined score image (the paper's non-minimal suppression over
+    /// the combined matching error `Pᵗ`): a candidate is dropped when a better detection's
+    /// head lies within `radius` × the larger body width horizontally and `radius` × the
+    /// larger body height vertically of its head (the score image's peaks stretch along the
+    /// body: a silhouette moved down its own axis by a tenth of its height still scores ~0.8).
+    Heads { radius: f64 },
+}
+
 /// Detector settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DetectorParams {
@@ -401,6 +496,7 @@ pub struct DetectorParams {
     pub nms_contained: f64,
     /// Fraction of a template window that must lie inside the image.
     pub min_inside: f64,
+    pub suppression: Suppression,
 }
 
 impl Default for DetectorParams {
@@ -411,6 +507,7 @@ impl Default for DetectorParams {
             nms_iou: 0.3,
             nms_contained: 0.7,
             min_inside: 0.5,
+            suppression: Suppression::Boxes,
         }
     }
 }
@@ -595,13 +692,10 @@ pub fn detect_with(
         let y = (yh - t.head.1.round() as i64) as f64;
         let b = t.body.map(f64::from);
         let bbox = [x + b[0], y + b[1], x + b[2], y + b[3]];
-        if out
-            .iter()
-            .any(|d| iou(&d.bbox, &bbox) > p.nms_iou || contained(&bbox, &d.bbox) > p.nms_contained)
-        {
+        let head_px = [x + t.head.0, y + t.head.1];
+        if out.iter().any(|d| suppresses(d, &bbox, head_px, t, p)) {
             continue;
         }
-        let head_px = [x + t.head.0, y + t.head.1];
         out.push(Detection {
             bbox,
             head_px,
@@ -613,6 +707,26 @@ pub fn detect_with(
         });
     }
     out
+}
+
+/// Whether detection `d` suppresses a worse candidate of template `t` with box `bbox` and head
+/// `head_px`.
+pub fn suppresses(
+    d: &Detection,
+    bbox: &[f64; 4],
+    head_px: [f64; 2],
+    t: &Silhouette,
+    p: &DetectorParams,
+) -> bool {
+    match p.suppression {
+        Suppression::Boxes => {
+            iou(&d.bbox, bbox) > p.nms_iou || contained(bbox, &d.bbox) > p.nms_contained
+        }
+        Suppression::Heads { radius } => {
+            (d.head_px[0] - head_px[0]).abs() < radius * d.width_px.max(t.body_width_px)
+                && (d.head_px[1] - head_px[1]).abs() < radius * d.height_px.max(t.body_height_px())
+        }
+    }
 }
 
 /// Centroid of the foreground pixels of `mask` inside `bbox` (pixel centres at `i + 0.5`).

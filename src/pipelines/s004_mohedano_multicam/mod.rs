@@ -46,7 +46,7 @@ use crate::groundtruth::PEOPLE_TOPIC;
 use crate::run::config::Invalid;
 use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
 
-pub use params::{BackgroundUpdate, Detector, Params};
+pub use params::{BackgroundUpdate, Detector, Nms, Params};
 
 pub struct MulticamCylinders;
 
@@ -83,7 +83,7 @@ pub(crate) fn topics(p: &Params, remap: &BTreeMap<String, String>) -> Topics {
 
 impl Experiment for MulticamCylinders {
     const KIND: &'static str = "s004_mohedano_multicam";
-    const VERSION: u32 = 3;
+    const VERSION: u32 = 4;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

@@ -27,6 +27,17 @@ pub enum BackgroundUpdate {
     Selective,
 }
 
+/// How the template detector suppresses overlapping candidates (`vision::template::Suppression`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Nms {
+    /// Boxes overlapping a better detection (`nms_iou`, `nms_contained`).
+    Boxes,
+    /// Local maxima of the combined score image: heads within `nms_head_radius` body widths
+    /// of a better detection's head (the paper's non-minimal suppression over Pᵗ).
+    Heads,
+}
+
 /// `[params]` of `pipelines/s004_mohedano_multicam.toml`; the file says where each default comes
 /// from.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -60,12 +71,21 @@ pub struct Params {
     /// Fraction of a template window the silhouette fills (a background margin is added
     /// around it; 1 = the silhouette's tight box).
     pub template_fill: f64,
+    /// The silhouettes' width relative to the profile's (`Silhouette::widened`).
+    pub template_width: f64,
+    /// Dilate each silhouette by this many pixels before adding the margin (the Gabor
+    /// envelope spreads a person's foreground by about σ; `Silhouette::grown`).
+    pub template_grow_px: u32,
     /// Try at each head position only the template the calibration predicts there
     /// (`vision::template::TemplateMap`); false: all templates everywhere.
     pub templates_by_position: bool,
     pub template_stride_px: u32,
+    pub nms: Nms,
     pub nms_iou: f64,
     pub nms_contained: f64,
+    /// `nms = "heads"`: suppression half-window in body widths (across) and body heights
+    /// (along the body).
+    pub nms_head_radius: f64,
     /// Head point of a box (log detections, ground-truth boxes): the box's top row on the
     /// image of the person's vertical (`track::cylinders::box_head_px`); false: the top centre.
     pub box_head_on_axis: bool,
@@ -135,10 +155,14 @@ impl Default for Params {
             template_tilts: 4,
             template_threshold: 0.7,
             template_fill: 0.5,
+            template_width: 1.0,
+            template_grow_px: 2,
             templates_by_position: true,
             template_stride_px: 2,
+            nms: Nms::Heads,
             nms_iou: 0.3,
             nms_contained: 0.7,
+            nms_head_radius: 0.5,
             box_head_on_axis: true,
             match_iou_2d: 0.1,
             max_missed_2d: 2,
@@ -163,6 +187,31 @@ impl Default for Params {
             write_tracks: String::new(),
             tracks_topic: "/tracks/cylinders".into(),
         }
+    }
+}
+
+/// The template shape and head-suppression checks (issue 32).
+fn validate_shapes(p: &Params, bad: &mut impl FnMut(&str, String)) {
+    if !(p.template_width >= 0.5 && p.template_width <= 3.0) {
+        bad(
+            "template_width",
+            format!(
+                "{} is not in [0.5, 3] × the profile's width",
+                p.template_width
+            ),
+        );
+    }
+    if p.template_grow_px > 16 {
+        bad(
+            "template_grow_px",
+            format!("{} is not in 0..=16 px", p.template_grow_px),
+        );
+    }
+    if !(p.nms_head_radius > 0.0 && p.nms_head_radius <= 5.0) {
+        bad(
+            "nms_head_radius",
+            format!("{} is not in (0, 5] body sizes", p.nms_head_radius),
+        );
     }
 }
 
@@ -229,6 +278,7 @@ pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
             bad(key, "scales × tilts must be between 1 and 64".into());
         }
     }
+    validate_shapes(p, &mut bad);
     if p.template_stride_px == 0 || p.template_stride_px > 16 {
         bad(
             "template_stride_px",

@@ -15,7 +15,8 @@ use rayon::prelude::*;
 use super::Params;
 use super::session::{main_detector, selection_label};
 use super::tables::{
-    self, CalibRow, CameraRow, Det2dRow, GtRow, HeadCentroidRow, SessionRow, TrackRow, VariantRow,
+    self, CalibRow, CameraRow, Det2dRow, Error2dRow, GtRow, HeadCentroidRow, SessionRow, TrackRow,
+    VariantRow,
 };
 use crate::eval::mot::{Evaluation, Geometry, GroundPoint, MatchRule, Observation, evaluate};
 use crate::report::rows::Rows;
@@ -50,6 +51,8 @@ pub(crate) struct SessionData {
     pub head_centroid: Vec<HeadCentroidRow>,
     pub cameras: Vec<CameraRow>,
     pub detections_2d: Vec<Det2dRow>,
+    /// The template chain's misses and false detections with their causes.
+    pub errors_2d: Vec<Error2dRow>,
     pub variants: Vec<VariantRow>,
     pub calibration: Vec<CalibRow>,
     pub session: SessionRow,
@@ -104,6 +107,7 @@ fn session_data(
         head_centroid: read(t, tables::HEAD_CENTROID, &label)?,
         cameras: read(t, tables::CAMERAS, &label)?,
         detections_2d: read(t, tables::DETECTIONS_2D, &label)?,
+        errors_2d: read(t, tables::ERRORS_2D, &label)?,
         variants: read(t, tables::VARIANTS, &label)?,
         calibration: read(t, tables::CALIBRATION, &label)?,
         session,

@@ -11,6 +11,8 @@ pub(crate) const GT: &str = "gt";
 pub(crate) const HEAD_CENTROID: &str = "head_centroid";
 pub(crate) const CAMERAS: &str = "cameras";
 pub(crate) const DETECTIONS_2D: &str = "detections_2d";
+/// Every miss and false detection of the template chain with its cause (`session::errors`).
+pub(crate) const ERRORS_2D: &str = "errors_2d";
 pub(crate) const VARIANTS: &str = "variants";
 /// MEASURED: seconds of the 3-D stage per frame (main run); left out by tools/compare_out.py.
 pub(crate) const TIMING_3D: &str = "timing_3d";
@@ -96,6 +98,30 @@ table_row! {
         pub head_dx_abs_px: f64,
         pub head_dy_px: f64,
         pub height_ratio: f64,
+    }
+}
+
+table_row! {
+    /// One miss or false detection of the template chain at one frame and camera, with its
+    /// cause (`session::errors`); scores are NaN where they do not apply.
+    #[derive(Debug, Clone, PartialEq)]
+    pub(crate) struct Error2dRow {
+        pub frame: i64,
+        pub camera: String,
+        /// "miss" or "false".
+        pub kind: String,
+        pub cause: String,
+        /// The missed person's id (-1 for a false detection).
+        pub person: i64,
+        pub visibility: f64,
+        pub speed_mps: f64,
+        /// Misses: the person's own silhouette at the true head, the best of the whole
+        /// template set and the best the detector tried near the head.
+        pub exact_score: f64,
+        pub any_score: f64,
+        pub set_score: f64,
+        /// False detections: the detection's score.
+        pub det_score: f64,
     }
 }
 

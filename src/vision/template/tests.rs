@@ -214,3 +214,170 @@ fn two_people_give_two_detections() {
     let dets = detect(&mask, std::slice::from_ref(&t), &DetectorParams::default());
     assert_eq!(dets.len(), 2, "{dets:?}");
 }
+
+/// The mask of a silhouette dilated by a square of radius `g`, pixel by pixel (the reference
+/// for [`Silhouette::grown`]).
+fn dilated_mask(t: &Silhouette, x: i64, y: i64, g: i64, w: u32, h: u32) -> Mask {
+    let mut base = Mask::new(w, h);
+    paint(&mut base, t, x, y);
+    let mut out = Mask::new(w, h);
+    for yy in 0..i64::from(h) {
+        for xx in 0..i64::from(w) {
+            let hit = (-g..=g).any(|dy| {
+                (-g..=g).any(|dx| {
+                    let (a, b) = (xx + dx, yy + dy);
+                    a >= 0
+                        && b >= 0
+                        && a < i64::from(w)
+                        && b < i64::from(h)
+                        && base.get(a as u32, b as u32) != 0
+                })
+            });
+            out.data[(yy * i64::from(w) + xx) as usize] = u8::from(hit);
+        }
+    }
+    out
+}
+
+#[test]
+fn a_grown_silhouette_is_the_pixelwise_dilation_and_reports_the_person() {
+    let t = Silhouette::new(50.0, 0.2);
+    let g = t.clone().grown(3);
+    assert_eq!((g.width, g.height), (t.width + 6, t.height + 6));
+    // painted at (20, 15), the grown one at (17, 12) covers exactly the dilated pixels
+    let want = dilated_mask(&t, 20, 15, 3, 100, 90);
+    let mut got = Mask::new(100, 90);
+    paint(&mut got, &g, 17, 12);
+    assert_eq!(got, want);
+    assert_eq!(g.area as usize, want.count());
+    // the person's box, head and width are the undilated silhouette's, 3 px inside
+    assert_eq!(g.body, [3, 3, t.width + 3, t.height + 3]);
+    assert_eq!(g.head, (t.head.0 + 3.0, t.head.1 + 3.0));
+    assert_eq!(g.body_height_px(), t.body_height_px());
+    assert_eq!(g.body_width_px, t.body_width_px);
+    assert_eq!(t.clone().grown(0), t);
+    // found on the dilated mask with a perfect score, reporting the person's own box (above
+    // 0.9: a placement moved 19 px down the body still scores 0.72, and box suppression keeps it)
+    let p = DetectorParams {
+        stride_px: 1,
+        threshold: 0.9,
+        ..Default::default()
+    };
+    let dets = detect(&want, std::slice::from_ref(&g.clone().padded(0.5)), &p);
+    assert_eq!(dets.len(), 1, "{dets:?}");
+    assert!((dets[0].score - 1.0).abs() < 1e-12);
+    assert_eq!(
+        dets[0].bbox,
+        [
+            20.0,
+            15.0,
+            20.0 + f64::from(t.width),
+            15.0 + f64::from(t.height)
+        ]
+    );
+    assert!((dets[0].head_px[0] - (20.0 + t.head.0)).abs() < 1e-9);
+    assert_eq!(dets[0].head_px[1], 15.0);
+}
+
+#[test]
+fn the_probe_sees_what_the_detector_tried_and_splits_the_error() {
+    let t = Silhouette::new(60.0, 0.0).padded(0.5);
+    let small = Silhouette::new(30.0, 0.0).padded(0.5);
+    let set = [small, t.clone()];
+    let mut mask = Mask::new(160, 120);
+    let tight = Silhouette::new(60.0, 0.0);
+    paint(&mut mask, &tight, 50, 30);
+    let head = [50.0 + tight.head.0, 30.0];
+    let p = DetectorParams {
+        stride_px: 1,
+        ..Default::default()
+    };
+    let dets = detect(&mask, &set, &p);
+    let probe = Probe::new(&mask, p.min_inside);
+    let fit = probe
+        .best_near(&set, None, head, 3.0, 1)
+        .expect("a placement");
+    // the best placement near the head is the detection
+    assert_eq!(fit.template, 1);
+    assert!((fit.score - 1.0).abs() < 1e-12);
+    assert_eq!(fit.bbox, dets[0].bbox);
+    // the same placement filled: nothing missing, nothing extra
+    let f = probe.fill_at(&t, head, 0).expect("allowed");
+    assert!((f.score - 1.0).abs() < 1e-12);
+    assert_eq!(
+        (f.inside, f.margin, f.missing, f.extra),
+        (1.0, 0.0, 0.0, 0.0)
+    );
+    // the small template alone: its best score near the head is below 1, as in the detector
+    let only_small = probe
+        .best_near(&set[..1], None, head, 3.0, 1)
+        .expect("a placement");
+    assert!(only_small.score < 0.9, "{only_small:?}");
+    // a band of foreground under the feet: extra margin pixels, all in the lower quarter
+    for y in 91..96u32 {
+        for x in 40..90u32 {
+            mask.data[(y * 160 + x) as usize] = 1;
+        }
+    }
+    let probe = Probe::new(&mask, p.min_inside);
+    let f = probe.fill_at(&t, head, 0).expect("allowed");
+    assert_eq!(f.missing, 0.0);
+    assert!(f.extra > 0.0 && f.margin_low == 1.0, "{f:?}");
+    assert!((f.score - (1.0 - f.extra)).abs() < 1e-12);
+}
+
+#[test]
+fn head_suppression_keeps_two_people_whose_boxes_overlap_where_they_are() {
+    // two people 60 px tall (14 px wide) side by side, heads 9 px apart (boxes at IoU 0.22):
+    // box suppression at IoU 0.1 drops the second person's own placement and keeps a worse
+    // one 10 px above their head; suppression over the score image in a window of half the
+    // body (7 x 30 px) keeps both people at their heads and nothing else
+    let t = Silhouette::new(60.0, 0.0);
+    assert_eq!(t.body_width_px, 14.0);
+    let mut mask = Mask::new(160, 100);
+    paint(&mut mask, &t, 40, 20);
+    paint(&mut mask, &t, 49, 20);
+    let set = [t.clone()];
+    let boxes = DetectorParams {
+        stride_px: 1,
+        threshold: 0.6,
+        nms_iou: 0.1,
+        ..Default::default()
+    };
+    let heads = DetectorParams {
+        suppression: Suppression::Heads { radius: 0.5 },
+        ..boxes
+    };
+    let (h0, h1) = ([40.0 + t.head.0, 20.0], [49.0 + t.head.0, 20.0]);
+    let near = |d: &Detection, h: [f64; 2]| (d.head_px[0] - h[0]).hypot(d.head_px[1] - h[1]) < 1.0;
+    let b = detect(&mask, &set, &boxes);
+    assert!(b.iter().any(|d| near(d, h0)), "{b:?}");
+    assert!(!b.iter().any(|d| near(d, h1)), "{b:?}");
+    let h = detect(&mask, &set, &heads);
+    assert_eq!(h.len(), 2, "{h:?}");
+    assert!(near(&h[0], h0) || near(&h[0], h1), "{h:?}");
+    assert!(near(&h[1], h0) || near(&h[1], h1), "{h:?}");
+}
+
+#[test]
+fn a_widened_silhouette_scales_every_row_about_its_centre() {
+    let t = Silhouette::new(80.0, 0.15);
+    assert_eq!(t.clone().widened(1.0), t);
+    let w = t.clone().widened(1.5);
+    assert_eq!(w.height, t.height);
+    // each row 1.5 times as wide (± rounding of both ends), centred where it was
+    let off = t.head.0 - w.head.0;
+    for (a, b) in t.spans.iter().zip(&w.spans) {
+        let (wa, wb) = (f64::from(a.1 - a.0), f64::from(b.1 - b.0));
+        assert!((wb - 1.5 * wa).abs() <= 1.0, "{a:?} {b:?}");
+        let (ca, cb) = (0.5 * f64::from(a.0 + a.1), 0.5 * f64::from(b.0 + b.1) + off);
+        assert!((ca - cb).abs() <= 0.5, "{a:?} {b:?}");
+    }
+    assert!((w.body_width_px - 1.5 * t.body_width_px).abs() <= 1.0);
+    assert_eq!(w.body, [0, 0, w.width, w.height]);
+    // a wide silhouette painted is found by its own template with a perfect score
+    let mut mask = Mask::new(160, 120);
+    paint(&mut mask, &w, 30, 20);
+    let dets = detect(&mask, std::slice::from_ref(&w), &DetectorParams::default());
+    assert!((dets[0].score - 1.0).abs() < 1e-12, "{dets:?}");
+}

@@ -3,12 +3,14 @@
 //! (the 3-D stage on ground-truth boxes), `position` (position, height and radius errors),
 //! `sweep` (`N_app` against latency and false alarms), `head_centroid` (t-test),
 //! `selection` (E_c vs E_m), `stages` (per-camera image stages), `detections_2d` (the
-//! template detector alone) and `search` (the 3-D search statistics). All read only the
+//! template detector alone), `error_causes` (its misses and false detections by cause) and
+//! `search` (the 3-D search statistics). All read only the
 //! [`Scored`] sessions.
 
 mod clear_mot;
 mod decompose;
 mod detections_2d;
+mod error_causes;
 mod gt_boxes;
 mod head_centroid;
 mod moda;
@@ -63,6 +65,9 @@ pub(crate) fn evaluate(s: &Scored, p: &Params, products: &mut Products) -> anyho
         } else {
             t.with_note(note)
         });
+    }
+    if let Some(t) = error_causes::table(s, &mut products.summary)? {
+        products.tables.push(t);
     }
     products.tables.push(search::table(s)?);
     products.tables.push(timing::table(s)?);

@@ -87,6 +87,7 @@ pub(crate) fn session() -> SessionData {
         head_centroid: Vec::new(),
         cameras: Vec::new(),
         detections_2d: Vec::new(),
+        errors_2d: Vec::new(),
         variants: Vec::new(),
         calibration: Vec::new(),
         timing: Vec::new(),

@@ -4,10 +4,12 @@
 use anyhow::Context;
 use image::RgbImage;
 
-use super::super::{BackgroundUpdate, Params};
+use super::super::{BackgroundUpdate, Nms, Params};
 use super::boxes::{box_head, boxes_from_detections, graph_params};
+use super::errors;
 use super::input::Payload;
 use crate::geometry::triangulate::CalibratedView;
+use crate::pipelines::s004_mohedano_multicam::tables::Error2dRow;
 use crate::track::cylinders::Object2d;
 use crate::track::graph_match::{Box2d, GraphTracker};
 use crate::vision::gabor::{GaborBackground, GaborBank, GaborParams, Mask, Update};
@@ -34,6 +36,9 @@ pub(crate) struct CameraOut {
     pub objects: Vec<Object2d>,
     pub failed: Option<String>,
     pub present: bool,
+    /// The misses and false detections of this frame with their causes (template chain, with
+    /// ground truth).
+    pub errors: Vec<Error2dRow>,
 }
 
 /// What every camera's chain shares.
@@ -56,6 +61,12 @@ impl ChainSetup {
                 stride_px: p.template_stride_px,
                 nms_iou: p.nms_iou,
                 nms_contained: p.nms_contained,
+                suppression: match p.nms {
+                    Nms::Boxes => template::Suppression::Boxes,
+                    Nms::Heads => template::Suppression::Heads {
+                        radius: p.nms_head_radius,
+                    },
+                },
                 ..DetectorParams::default()
             },
             use_images,
@@ -84,7 +95,11 @@ impl CameraChain {
             )
             .with_context(|| format!("{file}: templates of camera {}", p.cameras[c]))?
             .into_iter()
-            .map(|t| t.padded(p.template_fill))
+            .map(|t| {
+                t.widened(p.template_width)
+                    .grown(p.template_grow_px)
+                    .padded(p.template_fill)
+            })
             .collect()
         } else {
             Vec::new()
@@ -125,13 +140,14 @@ impl CameraChain {
     }
 
     /// One frame of this camera: its payload (none: the camera missed the frame) to 2-D
-    /// objects.
+    /// objects; with `truth`, the template chain's errors are named too.
     pub fn step(
         &mut self,
         payload: Option<Payload>,
         p: &Params,
         view: &CalibratedView,
         detector: &DetectorParams,
+        truth: Option<&errors::Context>,
     ) -> CameraOut {
         let mut out = CameraOut::default();
         let boxes: Vec<Box2d> = match payload {
@@ -143,7 +159,23 @@ impl CameraChain {
             Some(Payload::Image(img)) => {
                 out.present = true;
                 match img.decode() {
-                    Ok(rgb) => self.detect(&rgb, detector, &mut out),
+                    Ok(rgb) => {
+                        let boxes = self.detect(&rgb, detector, &mut out);
+                        if let Some(ctx) = truth
+                            && out.failed.is_none()
+                        {
+                            let ch = errors::Chain {
+                                camera: &p.cameras[self.camera],
+                                view,
+                                templates: &self.templates,
+                                map: self.map.as_ref(),
+                                detector,
+                                p,
+                            };
+                            out.errors = errors::classify(&ch, ctx, &self.mask, &out.detections);
+                        }
+                        boxes
+                    }
                     Err(e) => {
                         out.failed = Some(e.to_string());
                         Vec::new()

@@ -6,6 +6,7 @@
 mod boxes;
 mod calibration;
 mod chain;
+mod errors;
 mod gt_boxes;
 mod head_centroid;
 mod input;
@@ -15,6 +16,7 @@ mod truth;
 mod view;
 
 pub(crate) use boxes::MIN_BOX_HEIGHT_PX;
+pub(crate) use errors::{FALSE, MISS, STANDING_MPS};
 pub(crate) use head_centroid::{ASSOCIATION_IOU, CLEAR_VISIBILITY};
 pub(crate) use truth::DETECTION_HEAD_TOL;
 pub(crate) use view::shapes_from_rows;
@@ -160,6 +162,7 @@ pub(crate) fn process(
         tables::DETECTIONS_2D,
         tables::Det2dRow::frame(&scores.detections_2d(frames, &gt_for_frame))?,
     );
+    put(tables::ERRORS_2D, tables::Error2dRow::frame(&pass.errors)?);
     put(tables::VARIANTS, tables::VariantRow::frame(&runs.variants)?);
     let timing_rows: Vec<tables::Timing3dRow> = timing
         .iter()

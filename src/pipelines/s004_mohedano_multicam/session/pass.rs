@@ -8,6 +8,7 @@ use rayon::prelude::*;
 
 use super::super::{Params, Topics};
 use super::chain::{CameraChain, CameraOut, ChainSetup};
+use super::errors::{self, Visited};
 use super::input::{Payload, message_count};
 use crate::frames::multicam::{self, CameraPayload};
 use crate::frames::{ImageMsg, Skips, Stamped, truth};
@@ -15,7 +16,7 @@ use crate::geometry::triangulate::CalibratedView;
 use crate::groundtruth::PeopleFrame;
 use crate::log::SessionLog;
 use crate::log::msgs::Detection2DArray;
-use crate::pipelines::s004_mohedano_multicam::tables::CameraRow;
+use crate::pipelines::s004_mohedano_multicam::tables::{CameraRow, Error2dRow};
 use crate::progress::Progress;
 use crate::time::Nanos;
 use crate::track::cylinders::Object2d;
@@ -36,6 +37,8 @@ pub(crate) struct Pass {
     pub frames: Vec<FrameRec>,
     /// Per frame and camera (templates detector only).
     pub camera_rows: Vec<CameraRow>,
+    /// The template chain's misses and false detections with their causes (`errors`).
+    pub errors: Vec<Error2dRow>,
     /// Ground-truth frames by stamp.
     pub truth: Stamped<PeopleFrame>,
     pub bad_truth: usize,
@@ -76,6 +79,7 @@ impl Pass {
             }
             objects.extend(o.objects);
             detections.push(o.detections);
+            self.errors.extend(o.errors);
         }
         self.frames.push(FrameRec {
             stamp,
@@ -93,14 +97,19 @@ pub(crate) struct Chains<'a> {
 }
 
 impl Chains<'_> {
-    /// Every camera's chain on one frame's payloads, in parallel.
-    fn run(&mut self, payloads: Vec<Option<Payload>>, p: &Params) -> Vec<CameraOut> {
+    /// Every camera's chain on one frame's payloads, in parallel; `truth`: name the errors.
+    fn run(
+        &mut self,
+        payloads: Vec<Option<Payload>>,
+        p: &Params,
+        truth: Option<&errors::Context>,
+    ) -> Vec<CameraOut> {
         let (views, det) = (self.views, &self.setup.detector);
         self.chains
             .par_iter_mut()
             .zip(payloads.into_par_iter())
             .enumerate()
-            .map(|(c, (chain, payload))| chain.step(payload, p, &views[c], det))
+            .map(|(c, (chain, payload))| chain.step(payload, p, &views[c], det, truth))
             .collect()
     }
 }
@@ -140,8 +149,8 @@ fn frames_of<P: CameraPayload>(
     Ok(frames.into_skips())
 }
 
-/// Read the log's camera topics once, in time order, and run the chains on every frame; then
-/// the ground truth.
+/// Read the ground truth, then the log's camera topics once, in time order, and run the chains
+/// on every frame (naming the template chain's errors where the frame has ground truth).
 pub(crate) fn run_pass(
     log: &SessionLog,
     p: &Params,
@@ -154,9 +163,24 @@ pub(crate) fn run_pass(
     bar.set_length(length);
     bar.set_message("frames");
     let tol_ns = (p.sync_tolerance_s * 1e9) as u64;
+    let (people, bad) = truth::people(log, &t.ground_truth)?;
+    let visited = if use_images {
+        Visited::new(people.items())
+    } else {
+        Visited::default()
+    };
     let mut pass = Pass::default();
     let mut run = |stamp: Nanos, payloads: Vec<Option<Payload>>| {
-        let outs = chains.run(payloads, p);
+        // the same ground-truth frame `process` scores this frame against
+        let ctx = people
+            .nearest(stamp, tol_ns.max(1))
+            .filter(|_| use_images)
+            .map(|gt| errors::Context {
+                frame: pass.frames.len(),
+                gt,
+                visited: &visited,
+            });
+        let outs = chains.run(payloads, p, ctx.as_ref());
         pass.push_frame(stamp, outs, p, use_images);
         bar.inc(1);
     };
@@ -176,7 +200,6 @@ pub(crate) fn run_pass(
             primary.join(", ")
         );
     }
-    let (people, bad) = truth::people(log, &t.ground_truth)?;
     pass.truth = people;
     pass.bad_truth = bad.total() as usize;
     Ok(pass)

@@ -45,17 +45,16 @@ pub(crate) fn gt_rows(
         .collect()
 }
 
-/// Template detections of one camera against the truth's visible boxes: greedy one-to-one
-/// matching by increasing head distance; a detection's head point must lie within `head_tol`
-/// visible-box widths of the truth's head point (the point the 3-D stage triangulates; IoU
-/// would punish the full-body template box of a person whose legs a desk hides).
-pub(crate) fn det2d_row(
-    frame: usize,
-    camera: &str,
+/// One-to-one matching of detections to the truth's visible boxes: greedy by increasing head
+/// distance; a detection's head point must lie within `head_tol` visible-box widths of the
+/// truth's head point (the point the 3-D stage triangulates; IoU would punish the full-body
+/// template box of a person whose legs a desk hides). `(truth, detection)` pairs, nearest
+/// first.
+pub(crate) fn match_heads(
     truth: &[Box2d],
     dets: &[Detection],
     head_tol: f64,
-) -> Det2dRow {
+) -> Vec<(usize, usize)> {
     let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
     for (i, t) in truth.iter().enumerate() {
         for (j, d) in dets.iter().enumerate() {
@@ -67,13 +66,28 @@ pub(crate) fn det2d_row(
     }
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
     let (mut used_t, mut used_d) = (vec![false; truth.len()], vec![false; dets.len()]);
-    let (mut n, mut dx, mut dy, mut hr) = (0i64, 0.0, 0.0, 0.0);
+    let mut out = Vec::new();
     for (_, i, j) in pairs {
         if used_t[i] || used_d[j] {
             continue;
         }
         used_t[i] = true;
         used_d[j] = true;
+        out.push((i, j));
+    }
+    out
+}
+
+/// Template detections of one camera against the truth's visible boxes ([`match_heads`]).
+pub(crate) fn det2d_row(
+    frame: usize,
+    camera: &str,
+    truth: &[Box2d],
+    dets: &[Detection],
+    head_tol: f64,
+) -> Det2dRow {
+    let (mut n, mut dx, mut dy, mut hr) = (0i64, 0.0, 0.0, 0.0);
+    for (i, j) in match_heads(truth, dets, head_tol) {
         n += 1;
         dx += (dets[j].head_px[0] - truth[i].head_px[0]).abs();
         dy += dets[j].head_px[1] - truth[i].head_px[1];
