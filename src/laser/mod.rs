@@ -15,6 +15,10 @@
 //!    person from [`crate::track::kalman`], global nearest neighbour with a Mahalanobis gate
 //!    through [`crate::assign`], M-of-N initiation and deletion, single-leg updates).
 //!
+//! [`occupancy`] is leg_tracker's local occupancy grid (the scans mapped in the fixed frame,
+//! tracked people left out), which the tracker's motion confirmation asks whether a track moves
+//! through free space; [`people`] holds the two together (`FreeSpaceTracker`).
+//!
 //! [`follow`] is seed 001's single-target follower: blobs, their colour likelihood in the omni
 //! image ([`crate::vision::cylinder`]) and a PDAF ([`crate::track::pdaf`]) with the `rst` rule.
 //!
@@ -30,6 +34,8 @@ pub mod circle;
 pub mod features;
 pub mod follow;
 pub mod legs;
+pub mod occupancy;
+pub mod people;
 pub mod points;
 pub mod segment;
 pub mod tracker;

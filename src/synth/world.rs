@@ -658,6 +658,10 @@ impl World {
             let r = rng::stream(s.scenario.seed, "scatter", session);
             push_scatter(sc, w.size, r, &mut statics, &mut obstacles);
         }
+        if let Some(c) = &w.clutter {
+            let r = rng::stream(s.scenario.seed, "clutter", session);
+            super::clutter::push_clutter(c, r, &mut statics, &mut obstacles);
+        }
         let moving = moving_background(s, session, &mut statics);
         let sun = if w.kind == WorldKind::Outdoor {
             Vector3::new(0.4, 0.3, 0.87).normalize()

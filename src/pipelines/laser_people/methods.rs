@@ -13,6 +13,16 @@
 //!   the legs paired into people as the seed 002 model pairs them ([`legs::pair`]) →
 //!   [`PeopleTracker`]. A leg's position is its fitted circle's centre when a circle of radius
 //!   ≤ [`LEARNED_MAX_RADIUS_M`] fits facing the laser, else the segment's centroid.
+//! - **`legs_free_space`**: the seed 002 leg model → [`PeopleTracker`] with leg_tracker's
+//!   motion confirmation ([`FreeSpaceTracker`]): a track is reported once it has moved
+//!   0.5 m through free space of a local occupancy grid built online from the scans
+//!   (leg_tracker's; the beams of the legs that updated reported people count as free), and
+//!   reported people take no observation outside free space.
+//! - **`learned_free_space`** / **`learned_synthetic_free_space`**: the same tracker and grid
+//!   fed by a random forest over leg_tracker's 17 cluster features (`[params.learned_free_space]`:
+//!   trained on the real CSVs / on the synthetic logs, `laser_clutter` included); a leg is a
+//!   segment whose probability reaches the CV-chosen threshold, its confidence that
+//!   probability.
 //! - **`nearest`**: the baseline without a filter: the midpoint of the two legs nearest to the
 //!   laser (any distance apart), one hypothesis with id 1 on each scan with two legs or more.
 //!
@@ -28,12 +38,13 @@ use super::learned::{self, LearnedParams, LegModel, Source, Unavailable};
 use crate::laser::features;
 use crate::laser::legs::Leg;
 use crate::laser::points::to_fixed;
-use crate::laser::training::{Segmented, centroid, sample_features};
+use crate::laser::training::{Segmented, centroid};
 
 use crate::frames::laser::LaserFrame;
 use crate::laser::legs::{self, Detections, LegParams};
 use crate::laser::points::{self, ScanGeometry, ScanPoint};
 use crate::laser::segment::{self, Segment, SegmentOptions};
+use crate::laser::people::FreeSpaceTracker;
 use crate::laser::tracker::{
     Association, JpdaParams, LEG_ONLY_SCANS, PeopleTracker, TrackerParams,
 };
@@ -48,6 +59,9 @@ pub enum Method {
     Nearest,
     Learned,
     LearnedSynthetic,
+    LegsFreeSpace,
+    LearnedFreeSpace,
+    LearnedSyntheticFreeSpace,
 }
 
 impl Method {
@@ -60,6 +74,9 @@ impl Method {
             Method::Nearest => "nearest",
             Method::Learned => "learned",
             Method::LearnedSynthetic => "learned_synthetic",
+            Method::LegsFreeSpace => "legs_free_space",
+            Method::LearnedFreeSpace => "learned_free_space",
+            Method::LearnedSyntheticFreeSpace => "learned_synthetic_free_space",
         }
     }
 
@@ -84,16 +101,36 @@ impl Method {
             Method::LearnedSynthetic => {
                 "the same classifier trained on the synthetic datasets only (in-sample on the synthetic sequences), seed 002 pairing + PeopleTracker"
             }
+            Method::LegsFreeSpace => {
+                "seed 002 leg model + PeopleTracker with leg_tracker's motion confirmation (0.5 m through free space of the local occupancy grid; reported people take only free-space observations)"
+            }
+            Method::LearnedFreeSpace => {
+                "random forest on leg_tracker's 17 features trained on the real leg_tracker CSVs, seed 002 pairing, occupancy grid + motion confirmation as legs_free_space"
+            }
+            Method::LearnedSyntheticFreeSpace => {
+                "the same on leg_tracker's features trained on the synthetic datasets (laser_clutter included), grid + motion confirmation"
+            }
         }
     }
 
     /// The training data of a learned method.
     pub fn source(self) -> Option<Source> {
         match self {
-            Method::Learned => Some(Source::Real),
-            Method::LearnedSynthetic => Some(Source::Synthetic),
+            Method::Learned | Method::LearnedFreeSpace => Some(Source::Real),
+            Method::LearnedSynthetic | Method::LearnedSyntheticFreeSpace => {
+                Some(Source::Synthetic)
+            }
             _ => None,
         }
+    }
+
+    /// Whether the method's detector is trained with `[params.learned_free_space]` (else
+    /// `[params.learned]`).
+    pub fn free_space(self) -> bool {
+        matches!(
+            self,
+            Method::LegsFreeSpace | Method::LearnedFreeSpace | Method::LearnedSyntheticFreeSpace
+        )
     }
 }
 
@@ -146,6 +183,8 @@ pub enum Runner {
     Tracked(Box<PeopleTracker>),
     Nearest,
     Learned(Arc<LegModel>, Box<PeopleTracker>),
+    /// Occupancy grid + motion confirmation, with the leg model (`None`) or a forest.
+    FreeSpace(Option<Arc<LegModel>>, Box<FreeSpaceTracker>),
 }
 
 impl Runner {
@@ -159,7 +198,19 @@ impl Runner {
         gt_topic: &str,
     ) -> anyhow::Result<Option<Runner>> {
         let tracker = || Box::new(PeopleTracker::new(TrackerParams::default()));
+        let free = || Box::new(FreeSpaceTracker::default());
         Ok(Some(match method {
+            Method::LegsFreeSpace => Runner::FreeSpace(None, free()),
+            Method::LearnedFreeSpace | Method::LearnedSyntheticFreeSpace => {
+                let source = method.source().unwrap_or(Source::Real);
+                match learned::model(source, p, scan_topic, gt_topic) {
+                    Ok(m) => Runner::FreeSpace(Some(m), free()),
+                    Err(Unavailable::Absent(_)) => return Ok(None),
+                    Err(Unavailable::Failed(e)) => {
+                        anyhow::bail!("training the {} leg detector: {e}", method.name())
+                    }
+                }
+            }
             Method::Legs => Runner::Tracked(tracker()),
             Method::LegsJpda => Runner::Tracked(Box::new(PeopleTracker::new(TrackerParams {
                 association: Association::Jpda(JpdaParams::default()),
@@ -189,9 +240,16 @@ impl Runner {
         match self {
             Runner::Tracked(tracker) => track(tracker, &view.geometric, time_s),
             Runner::Learned(model, tracker) => {
-                let d = learned_legs(model, view);
+                let (d, _) = learned_legs(model, view);
                 track(tracker, &d, time_s)
             }
+            Runner::FreeSpace(model, fs) => match model {
+                Some(m) => {
+                    let (d, conf) = learned_legs(m, view);
+                    track_free_space(fs, view, &d, &conf, time_s)
+                }
+                None => track_free_space(fs, view, &view.geometric, &[], time_s),
+            },
             Runner::Nearest => nearest_pair(&view.geometric)
                 .map(|(laser, world)| Hypothesis {
                     id: 1,
@@ -204,9 +262,10 @@ impl Runner {
     }
 }
 
-/// The legs the classifier finds among the scan's segments, paired as seed 002 pairs them.
-/// A classifier error (a model of another feature width) finds no legs.
-fn learned_legs(model: &LegModel, view: &ScanView) -> Detections {
+/// The legs the classifier finds among the scan's segments, paired as seed 002 pairs them,
+/// with each leg's probability. A classifier error (a model of another feature width) finds
+/// no legs.
+fn learned_legs(model: &LegModel, view: &ScanView) -> (Detections, Vec<f64>) {
     let s = Segmented {
         points: view.points.clone(),
         segments: view.segments.clone(),
@@ -215,17 +274,20 @@ fn learned_legs(model: &LegModel, view: &ScanView) -> Detections {
             .iter()
             .map(|g| centroid(&view.points, g))
             .collect(),
+        geometry: ScanGeometry::of(&view.frame.scan),
+        ranges: view.frame.scan.ranges.clone(),
     };
-    let x: Vec<Vec<f64>> = (0..s.segments.len())
-        .map(|i| sample_features(&s, i))
+    let rows: Vec<(usize, Vec<f64>)> = (0..s.segments.len())
+        .filter_map(|i| model.features_of(&s, i).map(|f| (i, f)))
         .collect();
+    let x: Vec<Vec<f64>> = rows.iter().map(|(_, f)| f.clone()).collect();
     let prob = model.probability(&x).unwrap_or_default();
     let pose = view.frame.pose.as_ref();
-    let legs: Vec<Leg> = prob
+    let (legs, conf): (Vec<Leg>, Vec<f64>) = rows
         .iter()
-        .enumerate()
+        .zip(&prob)
         .filter(|(_, p)| **p >= model.threshold)
-        .map(|(i, _)| {
+        .map(|(&(i, _), &p)| {
             let features = features::compute(&s.points, &s.segments[i]);
             let c = s.centroids[i];
             let (sensor, radius) = match features.circle {
@@ -237,21 +299,39 @@ fn learned_legs(model: &LegModel, view: &ScanView) -> Detections {
                 }
                 _ => (c, 0.0),
             };
-            Leg {
+            let leg = Leg {
                 segment: s.segments[i].clone(),
                 features,
                 sensor,
                 fixed: to_fixed(pose, sensor),
                 radius,
-            }
+            };
+            (leg, p)
         })
-        .collect();
+        .unzip();
     let (people, single_legs) = legs::pair(&legs, LegParams::default().pair_distance);
-    Detections {
-        legs,
-        people,
-        single_legs,
-    }
+    (
+        Detections {
+            legs,
+            people,
+            single_legs,
+        },
+        conf,
+    )
+}
+
+/// One scan through a free-space method ([`FreeSpaceTracker::step`]); its reported people.
+fn track_free_space(
+    fs: &mut FreeSpaceTracker,
+    view: &ScanView,
+    d: &Detections,
+    conf: &[f64],
+    time_s: f64,
+) -> Vec<Hypothesis> {
+    let g = ScanGeometry::of(&view.frame.scan);
+    let pose = view.frame.pose.as_ref();
+    fs.step(time_s, d, conf, &view.points, &view.frame.scan.ranges, &g, pose);
+    hypotheses(&fs.tracker)
 }
 
 /// Leg pairs and single legs of `d` into `tracker`; its confirmed tracks.
@@ -259,6 +339,11 @@ fn track(tracker: &mut PeopleTracker, d: &Detections, time_s: f64) -> Vec<Hypoth
     let people: Vec<Point2<f64>> = d.people.iter().map(|p| p.fixed).collect();
     let single: Vec<Point2<f64>> = d.single_legs.iter().map(|&i| d.legs[i].fixed).collect();
     tracker.step(time_s, &people, &single);
+    hypotheses(tracker)
+}
+
+/// The confirmed tracks as hypotheses.
+fn hypotheses(tracker: &PeopleTracker) -> Vec<Hypothesis> {
     tracker
         .confirmed()
         .map(|t| Hypothesis {

@@ -206,7 +206,7 @@ pub(super) fn process(
     for &m in &p.methods {
         if let Some(r) = Runner::new(
             m,
-            &p.learned,
+            p.learned_for(m),
             &p.synthetic.scan_topic,
             &p.synthetic.gt_topic,
         )? {

@@ -1,6 +1,8 @@
 //! The methods replayed on a log, open loop, one scan at a time: `laser::follow`'s follower
-//! in each configuration, and the laser issue's multi-person tracker (`laser::tracker`, at its
-//! defaults, leg model of seed 002) reduced to one target: the confirmed track nearest the
+//! in each configuration, and the laser issue's multi-person tracker (since issue 35
+//! `laser::people::FreeSpaceTracker`: `laser::tracker` with leg_tracker's motion confirmation
+//! over a local occupancy grid, leg model of seed 002; the grid is built from the scan's
+//! returns, beams without one left unknown) reduced to one target: the confirmed track nearest the
 //! target's initial point is followed; when it ends, the confirmed track nearest its last
 //! position within the follower's re-initialisation radius takes over.
 
@@ -11,7 +13,8 @@ use crate::laser::follow::{FollowTracker, OmniFrame, ScanObs, StepOutput};
 use crate::laser::legs::{self, LegParams};
 use crate::laser::points::ScanPoint;
 use crate::laser::segment::{self, SegmentOptions};
-use crate::laser::tracker::{PeopleTracker, TrackerParams};
+use crate::laser::people::{FreeSpaceTracker, ranges_from_points};
+use crate::laser::points::ScanGeometry;
 
 /// One method's state over a session.
 pub enum Runner {
@@ -21,7 +24,7 @@ pub enum Runner {
 
 /// The multi-person tracker and the track it follows.
 pub struct LaserSelect {
-    tracker: PeopleTracker,
+    tracker: FreeSpaceTracker,
     anchor: [f64; 2],
     id: Option<u64>,
     radius: f64,
@@ -43,7 +46,7 @@ impl Runner {
                 Runner::Follower(Box::new(FollowTracker::new(&fp, init)))
             }
             Method::LaserTracker => Runner::Laser(Box::new(LaserSelect {
-                tracker: PeopleTracker::new(TrackerParams::default()),
+                tracker: FreeSpaceTracker::default(),
                 anchor: init,
                 id: None,
                 radius: p.follower.reinit_radius_m,
@@ -77,12 +80,10 @@ impl LaserSelect {
         let segs = segment::segment(points, &SegmentOptions::default());
         let d = legs::detect(points, &segs, beams, pose, &LegParams::default());
         let people: Vec<Point2<f64>> = d.people.iter().map(|p| p.fixed).collect();
-        let single: Vec<Point2<f64>> = d
-            .single_legs
-            .iter()
-            .filter_map(|&i| d.legs.get(i).map(|l| l.fixed))
-            .collect();
-        self.tracker.step(t, &people, &single);
+        let ranges = ranges_from_points(points, beams);
+        let g = geometry_of(points);
+        self.tracker.step(t, &d, &[], points, &ranges, &g, pose);
+        let tracker = &self.tracker.tracker;
         let mut out = StepOutput {
             estimate: None,
             reset: false,
@@ -95,13 +96,12 @@ impl LaserSelect {
         };
         let current = self
             .id
-            .and_then(|id| self.tracker.confirmed().find(|tr| tr.id == id));
+            .and_then(|id| tracker.confirmed().find(|tr| tr.id == id));
         let track = match current {
             Some(tr) => Some(tr),
             None => {
                 let a = Point2::new(self.anchor[0], self.anchor[1]);
-                let pick = self
-                    .tracker
+                let pick = tracker
                     .confirmed()
                     .filter(|tr| (tr.position() - a).norm() <= self.radius)
                     .min_by(|x, y| {
@@ -134,6 +134,25 @@ impl LaserSelect {
             });
         }
         out
+    }
+}
+
+/// The beam geometry of a scan rebuilt from its returns (two returns fix the first bearing
+/// and the increment; the range limits are those of the returns, wide enough for the grid).
+fn geometry_of(points: &[ScanPoint]) -> ScanGeometry {
+    let (inc, min) = match (points.first(), points.last()) {
+        (Some(a), Some(b)) if b.beam > a.beam => {
+            let inc = (b.angle - a.angle) / (b.beam - a.beam) as f64;
+            (inc, a.angle - a.beam as f64 * inc)
+        }
+        _ => (0.0, 0.0),
+    };
+    let max = points.iter().map(|p| p.range).fold(0.0, f64::max);
+    ScanGeometry {
+        angle_min: min,
+        angle_increment: inc,
+        range_min: 0.0,
+        range_max: max + 1e-6,
     }
 }
 
