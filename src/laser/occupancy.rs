@@ -379,8 +379,10 @@ mod tests {
         for _ in 0..5 {
             grid.update(&ranges, &g, None, &[]);
         }
+        // five hits from the clamped free prior: still below ½ (≈ 0.065)
         let hit = grid.occupancy(Point2::new(2.0, 0.0)).expect("on");
-        assert!(hit > 0.5, "{hit}");
+        let five = logistic(logit(P_MIN) + 5.0 * logit(P_OBSTACLE));
+        assert!((hit - five).abs() < 1e-5, "{hit} vs {five}");
         let pose = Isometry3::from_parts(
             Translation3::new(1.0, 0.0, 0.0),
             UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2),

@@ -60,50 +60,25 @@ pub fn push_clutter(
         None
     };
     let span = |r: &mut rand_chacha::ChaCha8Rng, [a, b]: [f64; 2]| a + (b - a) * r.random::<f64>();
-    for _ in 0..c.poles {
-        let rad = span(&mut r, c.pole_radius);
-        if let Some((x, y)) = place(&mut r, obstacles, rad) {
-            statics.push(leg(x, y, rad, 1.0 + r.random::<f64>()));
-        }
-    }
-    for _ in 0..c.trunks {
-        let rad = span(&mut r, c.trunk_radius);
-        if let Some((x, y)) = place(&mut r, obstacles, rad) {
-            statics.push(leg(x, y, rad, 3.0));
-        }
-    }
-    for _ in 0..c.tables {
-        let (w, d) = (span(&mut r, [1.0, 1.6]), span(&mut r, [0.6, 0.9]));
-        let (yaw, rad) = (r.random::<f64>() * std::f64::consts::PI, span(&mut r, [0.02, 0.035]));
-        if let Some((x, y)) = place(&mut r, obstacles, w.hypot(d) / 2.0) {
-            for (lx, ly) in corners(x, y, w, d, yaw, 0.06) {
-                statics.push(leg(lx, ly, rad, 0.72));
-            }
-            statics.push(Primitive::new(
-                Shape::Box {
-                    center: Point3::new(x, y, 0.74),
-                    half: Vector3::new(w / 2.0, d / 2.0, 0.02),
-                    yaw,
-                },
-                Material::flat([150, 120, 90]),
-                0,
-            ));
-        }
-    }
-    for _ in 0..c.chairs {
-        let (yaw, rad) = (r.random::<f64>() * std::f64::consts::PI, span(&mut r, [0.012, 0.02]));
-        if let Some((x, y)) = place(&mut r, obstacles, 0.3) {
-            for (lx, ly) in corners(x, y, 0.42, 0.42, yaw, 0.02) {
-                statics.push(leg(lx, ly, rad, 0.45));
-            }
-        }
-    }
     for _ in 0..c.walls {
-        let (len, yaw) = (span(&mut r, [3.0, 6.0]), r.random::<f64>() * std::f64::consts::PI);
-        let Some((x, y)) = place(&mut r, obstacles, len / 2.0) else {
+        // walls first, while there is room; both ends inside the area
+        let inside = |x: f64, y: f64| x >= x0 && x <= x1 && y >= y0 && y <= y1;
+        let mut found = None;
+        for _ in 0..100 {
+            let (len, yaw) = (span(&mut r, [3.0, 6.0]), r.random::<f64>() * std::f64::consts::PI);
+            let Some((x, y)) = place(&mut r, obstacles, 0.3) else {
+                break;
+            };
+            obstacles.pop(); // the placing disc: people walk through the gaps
+            let (dx, dy) = (yaw.cos() * len / 2.0, yaw.sin() * len / 2.0);
+            if inside(x - dx, y - dy) && inside(x + dx, y + dy) {
+                found = Some((x, y, len, yaw));
+                break;
+            }
+        }
+        let Some((x, y, len, yaw)) = found else {
             continue;
         };
-        obstacles.pop(); // the placing disc: people walk through the gaps
 
         // pieces between one or two gaps, along the wall's direction
         let gaps = 1 + usize::from(r.random::<f64>() < 0.5);
@@ -140,6 +115,44 @@ pub fn push_clutter(
                 });
             }
             start = start.max(b);
+        }
+    }
+    for _ in 0..c.poles {
+        let rad = span(&mut r, c.pole_radius);
+        if let Some((x, y)) = place(&mut r, obstacles, rad) {
+            statics.push(leg(x, y, rad, 1.0 + r.random::<f64>()));
+        }
+    }
+    for _ in 0..c.trunks {
+        let rad = span(&mut r, c.trunk_radius);
+        if let Some((x, y)) = place(&mut r, obstacles, rad) {
+            statics.push(leg(x, y, rad, 3.0));
+        }
+    }
+    for _ in 0..c.tables {
+        let (w, d) = (span(&mut r, [1.0, 1.6]), span(&mut r, [0.6, 0.9]));
+        let (yaw, rad) = (r.random::<f64>() * std::f64::consts::PI, span(&mut r, [0.02, 0.035]));
+        if let Some((x, y)) = place(&mut r, obstacles, w.hypot(d) / 2.0) {
+            for (lx, ly) in corners(x, y, w, d, yaw, 0.06) {
+                statics.push(leg(lx, ly, rad, 0.72));
+            }
+            statics.push(Primitive::new(
+                Shape::Box {
+                    center: Point3::new(x, y, 0.74),
+                    half: Vector3::new(w / 2.0, d / 2.0, 0.02),
+                    yaw,
+                },
+                Material::flat([150, 120, 90]),
+                0,
+            ));
+        }
+    }
+    for _ in 0..c.chairs {
+        let (yaw, rad) = (r.random::<f64>() * std::f64::consts::PI, span(&mut r, [0.012, 0.02]));
+        if let Some((x, y)) = place(&mut r, obstacles, 0.3) {
+            for (lx, ly) in corners(x, y, 0.42, 0.42, yaw, 0.02) {
+                statics.push(leg(lx, ly, rad, 0.45));
+            }
         }
     }
 }
