@@ -222,7 +222,10 @@ pub fn leg_tracker_features(
     }
     let nf = n as f64;
     let pts: Vec<Point2<f64>> = seg.iter().map(|p| p.sensor).collect();
-    let mean = pts.iter().fold(nalgebra::Vector2::zeros(), |a, p| a + p.coords) / nf;
+    let mean = pts
+        .iter()
+        .fold(nalgebra::Vector2::zeros(), |a, p| a + p.coords)
+        / nf;
     let median = |f: fn(&Point2<f64>) -> f64| {
         let mut v: Vec<f64> = pts.iter().map(f).collect();
         v.sort_by(f64::total_cmp);
@@ -251,13 +254,21 @@ pub fn leg_tracker_features(
         let (ml, mr) = (a - m, b - m);
         let l2 = mr.norm_squared();
         let th = ((ml.x * mr.y - ml.y * mr.x) / l2).atan2((ml.x * mr.x + ml.y * mr.y) / l2);
-        if th < 0.0 { th + std::f64::consts::TAU } else { th }
+        if th < 0.0 {
+            th + std::f64::consts::TAU
+        } else {
+            th
+        }
     };
     let (mut boundary, mut sum_sq_steps, mut curvature, mut ang_diff) = (0.0, 0.0, 0.0, 0.0);
     let mut last_seg = 0.0;
     for w in pts.windows(3) {
         let (right, mid, left) = (w[0], w[1], w[2]);
-        let (l_ml, l_mr, l_lr) = ((left - mid).norm(), (right - mid).norm(), (left - right).norm());
+        let (l_ml, l_mr, l_lr) = (
+            (left - mid).norm(),
+            (right - mid).norm(),
+            (left - right).norm(),
+        );
         boundary += l_mr;
         sum_sq_steps += l_mr * l_mr;
         last_seg = l_ml;
@@ -284,7 +295,11 @@ pub fn leg_tracker_features(
         let Some(k) = nb else { return 1.0 };
         let r = ranges.get(k).map_or(f64::NAN, |&r| f64::from(r));
         let present = r > geometry.range_min && r < geometry.range_max;
-        if present && (end.range < r || r < 0.01) { 0.0 } else { 1.0 }
+        if present && (end.range < r || r < 0.01) {
+            0.0
+        } else {
+            1.0
+        }
     };
     let (s0, s1) = (&seg[0], &seg[n - 1]);
     let occluded_left = occluded(s0, s0.beam.checked_sub(1));

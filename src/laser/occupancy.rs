@@ -107,10 +107,7 @@ pub fn cell_update(d: f64, r: f32, human: bool, g: &ScanGeometry, p: &GridParams
     if !valid || !d.is_finite() {
         return CellUpdate::Unknown;
     }
-    if d > g.range_max
-        || d > r + ALPHA_M / 2.0
-        || (r.is_infinite() && d > p.reliable_inf_range_m)
-    {
+    if d > g.range_max || d > r + ALPHA_M / 2.0 || (r.is_infinite() && d > p.reliable_inf_range_m) {
         return CellUpdate::Unknown;
     }
     if r < g.range_max && (d - r).abs() < ALPHA_M / 2.0 && !human {
@@ -193,7 +190,10 @@ impl LocalGrid {
             return;
         };
         let res = self.params.resolution_m;
-        let (tx, ty) = (((x - cx) / res).round() as i64, ((y - cy) / res).round() as i64);
+        let (tx, ty) = (
+            ((x - cx) / res).round() as i64,
+            ((y - cy) / res).round() as i64,
+        );
         let n = self.n() as i64;
         let unseen = logit(P_MIN) as f32;
         let mut moved = vec![unseen; self.l.len()];
@@ -228,8 +228,7 @@ impl LocalGrid {
             None => (0.0, 0.0, 0.0),
         };
         let inc_ok = g.angle_increment.is_finite() && g.angle_increment != 0.0;
-        if !(lx.is_finite() && ly.is_finite() && yaw.is_finite()) || ranges.is_empty() || !inc_ok
-        {
+        if !(lx.is_finite() && ly.is_finite() && yaw.is_finite()) || ranges.is_empty() || !inc_ok {
             return;
         }
         match self.centre {
@@ -270,11 +269,12 @@ impl LocalGrid {
                     continue;
                 }
                 let theta = wrap(dy.atan2(dx) - yaw);
-                if !(theta > g.angle_min - inc.abs() / 2.0 && theta < angle_max + inc.abs() / 2.0)
-                {
+                if !(theta > g.angle_min - inc.abs() / 2.0 && theta < angle_max + inc.abs() / 2.0) {
                     continue;
                 }
-                let k = ((theta - g.angle_min) / inc).round().clamp(0.0, last as f64) as usize;
+                let k = ((theta - g.angle_min) / inc)
+                    .round()
+                    .clamp(0.0, last as f64) as usize;
                 let human_k = human.get(k).copied().unwrap_or(false);
                 let add = match cell_update(d, ranges[k], human_k, g, &p) {
                     CellUpdate::Unknown => continue,
@@ -389,7 +389,11 @@ mod tests {
         );
         let far = vec![f32::INFINITY; 181];
         grid.update(&far, &g, Some(&pose), &[]);
-        assert_eq!(grid.origin(), Some([1.0 - 5.0, -5.0]), "shifted by 20 cells");
+        assert_eq!(
+            grid.origin(),
+            Some([1.0 - 5.0, -5.0]),
+            "shifted by 20 cells"
+        );
         // (2, 0) lies at bearing −90° from the new pose: on beam 0, nothing in range → free
         let after = grid.occupancy(Point2::new(2.0, 0.0)).expect("on");
         let want = logistic(logit(P_MIN) + 5.0 * logit(P_OBSTACLE) + logit(P_FREE));

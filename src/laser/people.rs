@@ -18,7 +18,9 @@ use nalgebra::Isometry3;
 use super::legs::Detections;
 use super::occupancy::{GridParams, LocalGrid};
 use super::points::{ScanGeometry, ScanPoint};
-use super::tracker::{Confirmation, MotionParams, Observation, PeopleTracker, TrackerParams, Update};
+use super::tracker::{
+    Confirmation, MotionParams, Observation, PeopleTracker, TrackerParams, Update,
+};
 
 /// The tracker and its grid.
 #[derive(Debug, Clone, PartialEq)]

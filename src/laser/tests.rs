@@ -9,8 +9,8 @@ use super::legs::{self, LegParams};
 use super::points::{self, ScanGeometry, ScanPoint};
 use super::segment::{self, SegmentOptions, Threshold};
 use super::tracker::{
-    Association, Confirmation, JpdaParams, MotionParams, Observation, PeopleTracker,
-    TrackerParams, Update,
+    Association, Confirmation, JpdaParams, MotionParams, Observation, PeopleTracker, TrackerParams,
+    Update,
 };
 
 fn beams(segs: &[segment::Segment]) -> Vec<(usize, usize)> {
@@ -681,7 +681,11 @@ fn confirmed_tracks_take_no_observation_outside_free_space() {
             } else {
                 // a pole at the track's last position: a pair on odd scans, a leg on even ones
                 let pole = at(2.45, 0.05, 0.8);
-                if i % 2 == 1 { (vec![pole], vec![]) } else { (vec![], vec![pole]) }
+                if i % 2 == 1 {
+                    (vec![pole], vec![])
+                } else {
+                    (vec![], vec![pole])
+                }
             };
             t.step_observed(time, &people, &legs);
             alive.push(t.confirmed().any(|tr| tr.id == 1));

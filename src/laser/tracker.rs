@@ -433,7 +433,9 @@ impl PeopleTracker {
         let gate = self.params.gate;
         max_score_pairs(candidates.len(), obs.len(), |i, j| {
             let z = &obs[j];
-            if !(z.x.is_finite() && z.y.is_finite()) || !self.may_take(candidates[i], meta[j].occupancy) {
+            if !(z.x.is_finite() && z.y.is_finite())
+                || !self.may_take(candidates[i], meta[j].occupancy)
+            {
                 return f64::NAN;
             }
             let d2 = mahalanobis2(&self.tracks[candidates[i]].filter, r, z);
@@ -577,9 +579,7 @@ impl PeopleTracker {
         history.push_back(true);
         let confirmed = match p.confirmation {
             Confirmation::MofN => p.confirm_m <= 1,
-            Confirmation::Motion(m) => {
-                m.min_travel_m <= 0.0 && z.confidence >= m.min_confidence
-            }
+            Confirmation::Motion(m) => m.min_travel_m <= 0.0 && z.confidence >= m.min_confidence,
         };
         let at = z.position;
         self.tracks.push(Track {

@@ -455,7 +455,10 @@ mod tests {
         assert_eq!(pos[0].features[0], 4.0); // four points
         assert_eq!(pos[0].features.len(), sample_feature_names().len());
         // negatives: both segments, then every second one
-        assert_eq!(negative_samples("n", &scans, 1, FeatureSet::Segment).len(), 2);
+        assert_eq!(
+            negative_samples("n", &scans, 1, FeatureSet::Segment).len(),
+            2
+        );
         let half = negative_samples("n", &scans, 2, FeatureSet::Segment);
         assert_eq!(half.len(), 1);
         assert_eq!(half[0].group, "n/l");

@@ -49,8 +49,14 @@ pub fn push_clutter(
     let [x0, y0, x1, y1] = c.area;
     let place = |r: &mut rand_chacha::ChaCha8Rng, obstacles: &mut Vec<Obstacle>, radius: f64| {
         for _ in 0..1000 {
-            let (x, y) = (x0 + r.random::<f64>() * (x1 - x0), y0 + r.random::<f64>() * (y1 - y0));
-            let clear = c.keep_clear.iter().all(|[cx, cy, cr]| (x - cx).hypot(y - cy) > cr + radius)
+            let (x, y) = (
+                x0 + r.random::<f64>() * (x1 - x0),
+                y0 + r.random::<f64>() * (y1 - y0),
+            );
+            let clear = c
+                .keep_clear
+                .iter()
+                .all(|[cx, cy, cr]| (x - cx).hypot(y - cy) > cr + radius)
                 && obstacles.iter().all(|o| o.distance(x, y) > radius + 0.6);
             if clear {
                 obstacles.push(Obstacle::disc(x, y, radius));
@@ -65,7 +71,10 @@ pub fn push_clutter(
         let inside = |x: f64, y: f64| x >= x0 && x <= x1 && y >= y0 && y <= y1;
         let mut found = None;
         for _ in 0..100 {
-            let (len, yaw) = (span(&mut r, [3.0, 6.0]), r.random::<f64>() * std::f64::consts::PI);
+            let (len, yaw) = (
+                span(&mut r, [3.0, 6.0]),
+                r.random::<f64>() * std::f64::consts::PI,
+            );
             let Some((x, y)) = place(&mut r, obstacles, 0.3) else {
                 break;
             };
@@ -131,7 +140,10 @@ pub fn push_clutter(
     }
     for _ in 0..c.tables {
         let (w, d) = (span(&mut r, [1.0, 1.6]), span(&mut r, [0.6, 0.9]));
-        let (yaw, rad) = (r.random::<f64>() * std::f64::consts::PI, span(&mut r, [0.02, 0.035]));
+        let (yaw, rad) = (
+            r.random::<f64>() * std::f64::consts::PI,
+            span(&mut r, [0.02, 0.035]),
+        );
         if let Some((x, y)) = place(&mut r, obstacles, w.hypot(d) / 2.0) {
             for (lx, ly) in corners(x, y, w, d, yaw, 0.06) {
                 statics.push(leg(lx, ly, rad, 0.72));
@@ -148,7 +160,10 @@ pub fn push_clutter(
         }
     }
     for _ in 0..c.chairs {
-        let (yaw, rad) = (r.random::<f64>() * std::f64::consts::PI, span(&mut r, [0.012, 0.02]));
+        let (yaw, rad) = (
+            r.random::<f64>() * std::f64::consts::PI,
+            span(&mut r, [0.012, 0.02]),
+        );
         if let Some((x, y)) = place(&mut r, obstacles, 0.3) {
             for (lx, ly) in corners(x, y, 0.42, 0.42, yaw, 0.02) {
                 statics.push(leg(lx, ly, rad, 0.45));

@@ -206,7 +206,11 @@ fn figures(
     leg: bool,
     prefix: &str,
 ) -> Vec<Figure> {
-    let what = if leg { "Leg clusters" } else { "Clutter (non-leg segments)" };
+    let what = if leg {
+        "Leg clusters"
+    } else {
+        "Clutter (non-leg segments)"
+    };
     wanted
         .iter()
         .filter_map(|f| names.iter().position(|n| n == f).map(|k| (f, k)))
@@ -251,7 +255,8 @@ fn figures(
 }
 
 /// leg_tracker features compared in the `lt_*` figures (legs and clutter).
-pub const LT_FIGURE_FEATURES: [&str; 5] = ["points", "width", "std_dev", "linearity", "circularity"];
+pub const LT_FIGURE_FEATURES: [&str; 5] =
+    ["points", "width", "std_dev", "linearity", "circularity"];
 
 /// The table and figures, when a learned method is listed: the `[params.learned]` models
 /// (source `real` / `synthetic`, figures `leg_features_*`) and, when a free-space learned
@@ -277,7 +282,14 @@ pub fn products(p: &Params, out: &mut Products) -> anyhow::Result<()> {
         rows_out.extend(models.iter().flat_map(|(s, m)| rows(s.name(), m)));
         if let (Ok(r), Ok(s)) = (&models[0].1, &models[1].1) {
             let names = sample_feature_names();
-            out.figures.extend(figures(&r.samples, &s.samples, &names, &FIGURE_FEATURES, true, "leg_features"));
+            out.figures.extend(figures(
+                &r.samples,
+                &s.samples,
+                &names,
+                &FIGURE_FEATURES,
+                true,
+                "leg_features",
+            ));
         }
     }
     if new {
@@ -290,7 +302,14 @@ pub fn products(p: &Params, out: &mut Products) -> anyhow::Result<()> {
         if let (Ok(r), Ok(s)) = (&models[0].1, &models[1].1) {
             let names = p.learned_free_space.feature_set.names();
             for (leg, prefix) in [(true, "lt_legs"), (false, "lt_clutter")] {
-                out.figures.extend(figures(&r.samples, &s.samples, &names, &LT_FIGURE_FEATURES, leg, prefix));
+                out.figures.extend(figures(
+                    &r.samples,
+                    &s.samples,
+                    &names,
+                    &LT_FIGURE_FEATURES,
+                    leg,
+                    prefix,
+                ));
             }
         }
     }

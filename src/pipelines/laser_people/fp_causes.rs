@@ -71,9 +71,13 @@ pub fn classify(
     tracks: &[TrackRow],
     match_m: f64,
 ) -> FpCauseRow {
-    let mine: Vec<&TrackRow> = tracks.iter().filter(|t| t.detector == row.detector).collect();
+    let mine: Vec<&TrackRow> = tracks
+        .iter()
+        .filter(|t| t.detector == row.detector)
+        .collect();
     let extent = extents(&mine);
-    let at: BTreeMap<(i64, i64), &TrackRow> = mine.iter().map(|t| ((t.scan_idx, t.id), *t)).collect();
+    let at: BTreeMap<(i64, i64), &TrackRow> =
+        mine.iter().map(|t| ((t.scan_idx, t.id), *t)).collect();
     let mut gt: BTreeMap<i64, Vec<&TruthRow>> = BTreeMap::new();
     for t in truth {
         gt.entry(t.scan_idx).or_default().push(t);
@@ -151,7 +155,13 @@ mod tests {
         };
         let got = classify(row, &[(0, 1), (1, 2), (1, 3), (1, 4)], &refs, &tracks, 0.75);
         assert_eq!(
-            (got.false_positives, got.unannotated_scan, got.near_person, got.static_track, got.other),
+            (
+                got.false_positives,
+                got.unannotated_scan,
+                got.near_person,
+                got.static_track,
+                got.other
+            ),
             (4, 1, 1, 1, 1)
         );
     }

@@ -199,8 +199,9 @@ pub fn real_samples(
             set.samples.extend(s);
             set.unmatched_labels += unmatched;
         } else if stem.starts_with("negative") {
-            set.samples
-                .extend(training::negative_samples(&stem, &scans, keep_every, features));
+            set.samples.extend(training::negative_samples(
+                &stem, &scans, keep_every, features,
+            ));
         }
     }
     Ok(set)
@@ -423,7 +424,12 @@ pub fn train(source: Source, set: TrainingSet, p: &LearnedParams) -> anyhow::Res
     Ok(LegModel {
         source,
         feature_set: p.feature_set,
-        features: p.feature_set.names().iter().map(|s| s.to_string()).collect(),
+        features: p
+            .feature_set
+            .names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
         threshold,
         positives: y.iter().filter(|&&v| v).count(),
         negatives: y.iter().filter(|&&v| !v).count(),

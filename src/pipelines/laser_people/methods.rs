@@ -42,9 +42,9 @@ use crate::laser::training::{Segmented, centroid};
 
 use crate::frames::laser::LaserFrame;
 use crate::laser::legs::{self, Detections, LegParams};
+use crate::laser::people::FreeSpaceTracker;
 use crate::laser::points::{self, ScanGeometry, ScanPoint};
 use crate::laser::segment::{self, Segment, SegmentOptions};
-use crate::laser::people::FreeSpaceTracker;
 use crate::laser::tracker::{
     Association, JpdaParams, LEG_ONLY_SCANS, PeopleTracker, TrackerParams,
 };
@@ -117,9 +117,7 @@ impl Method {
     pub fn source(self) -> Option<Source> {
         match self {
             Method::Learned | Method::LearnedFreeSpace => Some(Source::Real),
-            Method::LearnedSynthetic | Method::LearnedSyntheticFreeSpace => {
-                Some(Source::Synthetic)
-            }
+            Method::LearnedSynthetic | Method::LearnedSyntheticFreeSpace => Some(Source::Synthetic),
             _ => None,
         }
     }
@@ -330,7 +328,15 @@ fn track_free_space(
 ) -> Vec<Hypothesis> {
     let g = ScanGeometry::of(&view.frame.scan);
     let pose = view.frame.pose.as_ref();
-    fs.step(time_s, d, conf, &view.points, &view.frame.scan.ranges, &g, pose);
+    fs.step(
+        time_s,
+        d,
+        conf,
+        &view.points,
+        &view.frame.scan.ranges,
+        &g,
+        pose,
+    );
     hypotheses(&fs.tracker)
 }
 

@@ -5,9 +5,9 @@
 use serde::{Deserialize, Serialize};
 
 use super::learned::LearnedParams;
-use crate::laser::training::FeatureSet;
 use super::methods::Method;
 use crate::groundtruth::PEOPLE_TOPIC;
+use crate::laser::training::FeatureSet;
 use crate::run::config::Invalid;
 
 /// How one sequence (a session, by name) is read and scored.
@@ -69,7 +69,8 @@ pub fn learned_free_space_default() -> LearnedParams {
         negative_keep_every: 10,
         ..LearnedParams::default()
     };
-    p.synthetic_sessions.push("datasets/laser_clutter/*.mcap".into());
+    p.synthetic_sessions
+        .push("datasets/laser_clutter/*.mcap".into());
     p
 }
 
@@ -201,7 +202,10 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
         check_sequence(&key, s, &mut out);
     }
     check_sequence("synthetic", &p.synthetic, &mut out);
-    for (key, l) in [("learned", &p.learned), ("learned_free_space", &p.learned_free_space)] {
+    for (key, l) in [
+        ("learned", &p.learned),
+        ("learned_free_space", &p.learned_free_space),
+    ] {
         if l.folds < 2
             || l.n_trees == 0
             || l.negative_keep_every == 0

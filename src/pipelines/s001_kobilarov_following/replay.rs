@@ -11,10 +11,10 @@ use nalgebra::{Isometry3, Point2};
 use super::params::{Method, Params};
 use crate::laser::follow::{FollowTracker, OmniFrame, ScanObs, StepOutput};
 use crate::laser::legs::{self, LegParams};
-use crate::laser::points::ScanPoint;
-use crate::laser::segment::{self, SegmentOptions};
 use crate::laser::people::{FreeSpaceTracker, ranges_from_points};
 use crate::laser::points::ScanGeometry;
+use crate::laser::points::ScanPoint;
+use crate::laser::segment::{self, SegmentOptions};
 
 /// One method's state over a session.
 pub enum Runner {
