@@ -574,6 +574,63 @@ mod tests {
         }
     }
 
+    /// A model saved as `train leg-detector` saves it is what the pipeline uses when
+    /// `model` names the file (same source): same threshold, feature set and probabilities;
+    /// a file of the other source is ignored (that source trains, here: absent data).
+    #[test]
+    fn a_saved_model_file_is_loaded_for_its_source() {
+        let mut samples = Vec::new();
+        for k in 0..12 {
+            let x = f64::from(k);
+            for (g, leg) in [
+                ("positive_1", true),
+                ("positive_2", true),
+                ("negative_2/l", false),
+                ("negative_2/r", false),
+            ] {
+                samples.push(Sample {
+                    group: g.into(),
+                    scan_idx: k as usize,
+                    features: vec![if leg { 1.0 + x } else { -1.0 - x }; 17],
+                    range_m: 1.0,
+                    leg,
+                });
+            }
+        }
+        let p = LearnedParams {
+            feature_set: FeatureSet::LegTracker,
+            folds: 2,
+            n_trees: 5,
+            training_dir: "/nonexistent/leg_training".into(),
+            synthetic_sessions: vec!["/nonexistent/*.mcap".into()],
+            ..LearnedParams::default()
+        };
+        let set = TrainingSet {
+            samples,
+            unmatched_labels: 0,
+        };
+        let trained = train(Source::Real, set, &p).expect("trains");
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("legs.json");
+        std::fs::write(&path, serde_json::to_vec(&trained).expect("json")).expect("write");
+        let with_file = LearnedParams {
+            model: Some(path.display().to_string()),
+            ..p
+        };
+        let got = model(Source::Real, &with_file, "/scan", "/gt").expect("loaded");
+        assert_eq!(got.feature_set, FeatureSet::LegTracker);
+        assert_eq!(got.threshold, trained.threshold);
+        let x = vec![vec![3.0; 17], vec![-3.0; 17]];
+        assert_eq!(
+            got.probability(&x).expect("p"),
+            trained.probability(&x).expect("p")
+        );
+        assert!(matches!(
+            model(Source::Synthetic, &with_file, "/scan", "/gt"),
+            Err(Unavailable::Absent(_))
+        ));
+    }
+
     #[test]
     fn fold_score_counts() {
         let p = [0.9, 0.8, 0.2, 0.6, 0.1];
