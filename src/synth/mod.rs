@@ -14,7 +14,6 @@
 //! Not modelled: global illumination, cast shadows other than soft floor shadows under people,
 //! motion blur, rolling shutter, lens vignetting.
 
-pub mod clutter;
 pub mod follow;
 pub mod laser;
 pub mod motion;

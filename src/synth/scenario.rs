@@ -127,7 +127,7 @@ pub struct Scatter {
     pub keep_clear: Vec<[f64; 3]>,
 }
 
-/// Leg-like clutter for laser scenes (`[world.clutter]`; see `synth::clutter`).
+/// Leg-like clutter for laser scenes (`[world.clutter]`; see `synth::world::clutter`).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Clutter {

@@ -12,6 +12,8 @@ use super::scenario::{
 use super::shapes::Shape;
 use crate::rng;
 
+mod clutter;
+
 /// Object ids: 0 is static background, 1..PERSON_BASE moving background, PERSON_BASE + id a person.
 pub const PERSON_BASE: u32 = 1000;
 
@@ -660,7 +662,7 @@ impl World {
         }
         if let Some(c) = &w.clutter {
             let r = rng::stream(s.scenario.seed, "clutter", session);
-            super::clutter::push_clutter(c, r, &mut statics, &mut obstacles);
+            clutter::push_clutter(c, r, &mut statics, &mut obstacles);
         }
         let moving = moving_background(s, session, &mut statics);
         let sun = if w.kind == WorldKind::Outdoor {

@@ -13,9 +13,9 @@
 use nalgebra::{Point3, Vector3};
 use rand::RngExt;
 
-use super::scenario::Clutter;
-use super::shapes::Shape;
-use super::world::{Material, Obstacle, Primitive};
+use super::{Material, Obstacle, Primitive};
+use crate::synth::scenario::Clutter;
+use crate::synth::shapes::Shape;
 
 fn leg(x: f64, y: f64, r: f64, z1: f64) -> Primitive {
     Primitive::new(
