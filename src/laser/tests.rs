@@ -165,13 +165,13 @@ fn the_tracker_filter_matches_the_closed_form_for_one_step() {
 
 /// A synthetic scanner at the origin: 512 beams over ±90° (0.35°), 10 m range, a wall at
 /// x = 8 m, and legs as circles.
-struct Synth {
-    geometry: ScanGeometry,
-    beams: usize,
+pub(super) struct Synth {
+    pub(super) geometry: ScanGeometry,
+    pub(super) beams: usize,
 }
 
 impl Synth {
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         let inc = std::f64::consts::PI / 511.0;
         Synth {
             geometry: ScanGeometry {
@@ -184,7 +184,7 @@ impl Synth {
         }
     }
 
-    fn ranges(&self, circles: &[(Point2<f64>, f64)]) -> Vec<f32> {
+    pub(super) fn ranges(&self, circles: &[(Point2<f64>, f64)]) -> Vec<f32> {
         (0..self.beams)
             .map(|k| {
                 let th = self.geometry.angle(k);
@@ -222,7 +222,10 @@ impl Synth {
 }
 
 /// Two legs of radius 0.06 m, 0.1 m either side of `centre` across the walking direction.
-fn legs_of(centre: Point2<f64>, heading: nalgebra::Vector2<f64>) -> [(Point2<f64>, f64); 2] {
+pub(super) fn legs_of(
+    centre: Point2<f64>,
+    heading: nalgebra::Vector2<f64>,
+) -> [(Point2<f64>, f64); 2] {
     let n = nalgebra::Vector2::new(-heading.y, heading.x) * 0.1;
     [(centre + n, 0.06), (centre - n, 0.06)]
 }

@@ -32,6 +32,20 @@ pub struct Sequence {
     /// Ground truth and hypotheses farther than this from the laser are not scored (m).
     #[serde(default)]
     pub max_range_m: Option<f64>,
+    /// The methods do not see the log's TF (the ground truth still uses it): the free-space
+    /// methods run on scan-matched odometry, the others in the laser frame, as on a log without
+    /// odometry (issue 35: the synthetic logs made to look like `person_following_outdoor_1`).
+    #[serde(default)]
+    pub withhold_odometry: bool,
+    /// The free-space methods report people not matched on the current scan (leg_tracker's
+    /// `publish_occluded`; its default true, false in the authors' launch file of
+    /// `general_tracking_moving_1`).
+    #[serde(default = "yes")]
+    pub publish_occluded: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// `[params]`.
@@ -88,6 +102,8 @@ impl Default for Params {
                 scans: None,
                 wedge_deg: None,
                 max_range_m: None,
+                withhold_odometry: false,
+                publish_occluded: true,
             },
             methods: vec![Method::Legs, Method::Nearest],
             learned: LearnedParams::default(),

@@ -1,10 +1,11 @@
 //! The methods replayed on a log, open loop, one scan at a time: `laser::follow`'s follower
 //! in each configuration, and the laser issue's multi-person tracker (since issue 35
-//! `laser::people::FreeSpaceTracker`: `laser::tracker` with leg_tracker's motion confirmation
-//! over a local occupancy grid, leg model of seed 002; the grid is built from the scan's
-//! returns, beams without one left unknown) reduced to one target: the confirmed track nearest the
-//! target's initial point is followed; when it ends, the confirmed track nearest its last
-//! position within the follower's re-initialisation radius takes over.
+//! `laser::people::FreeSpaceTracker`: leg_tracker's joint tracker of `laser::joint` over a
+//! local occupancy grid, the seed 002 leg model's verdict as each cluster's confidence; the
+//! grid is built from the scan's returns, beams without one left unknown; the fixed frame is
+//! the log's TF, the laser's own frame without it) reduced to one target: the confirmed track
+//! nearest the target's initial point is followed; when it ends, the confirmed track nearest
+//! its last position within the follower's re-initialisation radius takes over.
 
 use nalgebra::{Isometry3, Point2};
 
