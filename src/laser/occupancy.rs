@@ -153,7 +153,7 @@ impl LocalGrid {
         let res = self.params.resolution_m;
         let (i, j) = (((p.x - ox) / res).round(), ((p.y - oy) / res).round());
         let n = self.n() as f64;
-        (i >= 0.0 && j >= 0.0 && i < n && j < n).then(|| (i as usize, j as usize))
+        (i >= 0.0 && j >= 0.0 && i < n && j < n).then_some((i as usize, j as usize))
     }
 
     /// Occupancy probability of the cell holding `p` (`None` off the grid).

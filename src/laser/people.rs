@@ -170,7 +170,10 @@ impl FreeSpaceTracker {
                 mark(&c.segment);
             }
         }
-        for c in clusters.iter().filter(|c| !(c.range < MAX_DETECT_M)) {
+        for c in clusters
+            .iter()
+            .filter(|c| c.range >= MAX_DETECT_M || c.range.is_nan())
+        {
             mark(&c.segment);
         }
         self.grid.update(ranges, g, pose, &human);

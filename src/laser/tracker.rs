@@ -433,8 +433,9 @@ impl PeopleTracker {
         let gate = self.params.gate;
         max_score_pairs(candidates.len(), obs.len(), |i, j| {
             let z = &obs[j];
-            if !(z.x.is_finite() && z.y.is_finite())
-                || !self.may_take(candidates[i], meta[j].occupancy)
+            if !(z.x.is_finite()
+                && z.y.is_finite()
+                && self.may_take(candidates[i], meta[j].occupancy))
             {
                 return f64::NAN;
             }
