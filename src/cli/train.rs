@@ -14,6 +14,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 
 use peopletrack::groundtruth::PEOPLE_TOPIC;
+use peopletrack::laser::training::FeatureSet;
 use peopletrack::pipelines;
 use peopletrack::pipelines::laser_people::LearnedParams;
 use peopletrack::pipelines::laser_people::learned::{self, Source, Unavailable};
@@ -40,12 +41,13 @@ pub enum Model {
     ///
     /// Each scan is cut into segments (jump distance 0.1 m, ≥ 3 points); a segment is
     /// described by 12 features (points, spread, width, linearity, circularity, fitted radius,
-    /// boundary length and regularity, mean curvature, two occlusion flags, range).
+    /// boundary length and regularity, mean curvature, two occlusion flags, range), or with
+    /// --features leg-tracker by leg_tracker's 17 cluster features.
     ///
     /// --source real reads leg_tracker's training CSVs (Leigh et al., ICRA 2015) in --dir:
     /// positive_K_scans.csv + positive_K_legs.csv (labelled leg centroids; the nearest
     /// segment within 0.1 m of a label is a leg) and negative_K_scans.csv (people-free scans;
-    /// every 50th segment is a non-leg). --source synthetic reads synthetic logs with
+    /// every --negative-keep-every-th segment is a non-leg). --source synthetic reads synthetic logs with
     /// /ground_truth/people (legs: segments near a ground-truth leg; non-legs: segments
     /// farther than 0.5 m from every leg, within 5 m).
     ///
@@ -53,8 +55,9 @@ pub enum Model {
     /// and F1 of k-fold cross-validation grouped by file, so that scans of one recording never
     /// sit on both sides; the probability threshold is the one with the best out-of-fold F1.
     /// The final model (all samples) is saved as JSON with its threshold and CV scores. The
-    /// same seed gives the same model. The pipeline trains the same model itself (it does not
-    /// load model files): this command shows and saves it, e.g. to train on your own CSVs.
+    /// same seed gives the same model. The pipeline trains the same model itself; to use a
+    /// saved one instead (e.g. trained on your own CSVs) set `model = "FILE"` in
+    /// `[params.learned]` or `[params.learned_free_space]` of pipelines/laser_people.toml.
     ///
     /// Example: peopletrack train leg-detector --out models/legs.json
     LegDetector(LegArgs),
@@ -81,9 +84,21 @@ pub struct LegArgs {
     pub trees: u16,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Segment features: ours (12) or leg_tracker's (17).
+    #[arg(long, value_enum, default_value = "segment")]
+    pub features: LegFeatures,
+    /// Real negatives: every n-th segment of the people-free scans (leg_tracker: 50).
+    #[arg(long, default_value_t = 50)]
+    pub negative_keep_every: usize,
     /// Where to write the cross-validation table (CSV).
     #[arg(long, value_name = "TABLE")]
     pub table: Option<PathBuf>,
+}
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum LegFeatures {
+    Segment,
+    LegTracker,
 }
 
 #[derive(Debug, Clone, Copy, clap::ValueEnum)]
@@ -164,11 +179,16 @@ fn leg_detector(a: &LegArgs, out: &mut dyn std::io::Write) -> anyhow::Result<()>
         folds: a.folds,
         n_trees: a.trees,
         seed: a.seed,
+        negative_keep_every: a.negative_keep_every,
+        feature_set: match a.features {
+            LegFeatures::Segment => FeatureSet::Segment,
+            LegFeatures::LegTracker => FeatureSet::LegTracker,
+        },
         ..LearnedParams::default()
     };
     anyhow::ensure!(
-        a.folds >= 2 && a.trees >= 1,
-        "--folds must be ≥ 2 and --trees ≥ 1"
+        a.folds >= 2 && a.trees >= 1 && a.negative_keep_every >= 1,
+        "--folds must be ≥ 2, --trees and --negative-keep-every ≥ 1"
     );
     let source = match a.source {
         LegSource::Real => Source::Real,

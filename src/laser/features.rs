@@ -177,3 +177,150 @@ fn menger(a: Point2<f64>, b: Point2<f64>, c: Point2<f64>) -> f64 {
     let cross = (b - a).x * (c - a).y - (b - a).y * (c - a).x;
     2.0 * cross.abs() / denom
 }
+
+/// Names of leg_tracker's 17 cluster features ([`leg_tracker_features`]), in its order.
+pub const LEG_TRACKER_FEATURE_NAMES: [&str; 17] = [
+    "points",
+    "std_dev",
+    "avg_median_dev",
+    "width",
+    "linearity",
+    "circularity",
+    "radius",
+    "boundary_length",
+    "boundary_regularity",
+    "mean_curvature",
+    "mean_angular_difference",
+    "inscribed_angle_mean",
+    "inscribed_angle_sd",
+    "distance",
+    "distance_per_point",
+    "occluded_right",
+    "occluded_left",
+];
+
+/// leg_tracker's cluster features (Leigh et al., ICRA 2015, `src/cluster_features.cpp`; read,
+/// not copied), on a segment of at least 3 points, in [`LEG_TRACKER_FEATURE_NAMES`] order and
+/// with its formulas, quirks included: `radius` is always 0 (it computes the fitted radius
+/// and then stores 0), `boundary_regularity` divides by the point count `n` where the step
+/// count is `n − 1`, `circularity` uses the plain algebraic (Kåsa) circle, the inscribed-angle
+/// mean divides by `n`, and an end is **not occluded** (0) only when its neighbouring beam has
+/// a return (`range_min < r < range_max`) that is farther than the end's range (or below
+/// 1 cm); a missing neighbour, or the scan's first or last beam, leaves it 1. Angles `th` are
+/// `atan2(B, A)` in `[0, 2π)`. `distance` is the norm of the median point (coordinate-wise
+/// medians). Fewer than 3 points gives `None`.
+pub fn leg_tracker_features(
+    points: &[ScanPoint],
+    segment: &Segment,
+    geometry: &super::points::ScanGeometry,
+    ranges: &[f32],
+) -> Option<[f64; 17]> {
+    let seg = points.get(segment.points.clone())?;
+    let n = seg.len();
+    if n < 3 {
+        return None;
+    }
+    let nf = n as f64;
+    let pts: Vec<Point2<f64>> = seg.iter().map(|p| p.sensor).collect();
+    let mean = pts
+        .iter()
+        .fold(nalgebra::Vector2::zeros(), |a, p| a + p.coords)
+        / nf;
+    let median = |f: fn(&Point2<f64>) -> f64| {
+        let mut v: Vec<f64> = pts.iter().map(f).collect();
+        v.sort_by(f64::total_cmp);
+        0.5 * (v[(n - 1) / 2] + v[n / 2])
+    };
+    let med = Point2::new(median(|p| p.x), median(|p| p.y));
+    let distance = med.coords.norm();
+    let sum_sq: f64 = pts.iter().map(|p| (p.coords - mean).norm_squared()).sum();
+    let std_dev = (sum_sq / (nf - 1.0)).sqrt();
+    let avg_median_dev = pts.iter().map(|p| (p - med).norm()).sum::<f64>() / nf;
+    let width = (pts[n - 1] - pts[0]).norm();
+    let scatter = pts.iter().fold(Matrix2::zeros(), |a, p| {
+        let d = p.coords - mean;
+        a + d * d.transpose()
+    });
+    let linearity = smallest_eigenvalue(&scatter);
+    let circularity = match circle::kasa(&pts) {
+        Some(c) => pts
+            .iter()
+            .map(|p| (c.radius - (p - c.centre).norm()).powi(2))
+            .sum(),
+        None => linearity, // collinear: a line is a circle of infinite radius
+    };
+    let angle = |a: Point2<f64>, m: Point2<f64>, b: Point2<f64>| {
+        // leg_tracker: A = (ml·mr)/|mr|², B = (ml × mr)/|mr|², th = atan2(B, A) in [0, 2π)
+        let (ml, mr) = (a - m, b - m);
+        let l2 = mr.norm_squared();
+        let th = ((ml.x * mr.y - ml.y * mr.x) / l2).atan2((ml.x * mr.x + ml.y * mr.y) / l2);
+        if th < 0.0 {
+            th + std::f64::consts::TAU
+        } else {
+            th
+        }
+    };
+    let (mut boundary, mut sum_sq_steps, mut curvature, mut ang_diff) = (0.0, 0.0, 0.0, 0.0);
+    let mut last_seg = 0.0;
+    for w in pts.windows(3) {
+        let (right, mid, left) = (w[0], w[1], w[2]);
+        let (l_ml, l_mr, l_lr) = (
+            (left - mid).norm(),
+            (right - mid).norm(),
+            (left - right).norm(),
+        );
+        boundary += l_mr;
+        sum_sq_steps += l_mr * l_mr;
+        last_seg = l_ml;
+        let th = angle(left, mid, right);
+        ang_diff += th / nf;
+        let s = 0.5 * (l_ml + l_mr + l_lr);
+        let area = (s * (s - l_ml) * (s - l_mr) * (s - l_lr)).max(0.0).sqrt();
+        let k = 4.0 * area / (l_ml * l_mr * l_lr * nf);
+        curvature += if th > 0.0 { k } else { -k };
+    }
+    boundary += last_seg;
+    sum_sq_steps += last_seg * last_seg;
+    let boundary_regularity = ((sum_sq_steps - boundary * boundary / nf) / (nf - 1.0)).sqrt();
+    let (first, last) = (pts[0], pts[n - 1]);
+    let (mut sum_iav, mut sum_iav_sq) = (0.0, 0.0);
+    for &mid in &pts[1..n - 1] {
+        let th = angle(first, mid, last);
+        sum_iav += th;
+        sum_iav_sq += th * th;
+    }
+    let iav = sum_iav / nf;
+    let std_iav = ((sum_iav_sq - sum_iav * sum_iav / nf) / (nf - 1.0)).sqrt();
+    let occluded = |end: &ScanPoint, nb: Option<usize>| -> f64 {
+        let Some(k) = nb else { return 1.0 };
+        let r = ranges.get(k).map_or(f64::NAN, |&r| f64::from(r));
+        let present = r > geometry.range_min && r < geometry.range_max;
+        if present && (end.range < r || r < 0.01) {
+            0.0
+        } else {
+            1.0
+        }
+    };
+    let (s0, s1) = (&seg[0], &seg[n - 1]);
+    let occluded_left = occluded(s0, s0.beam.checked_sub(1));
+    let occluded_right = occluded(s1, Some(s1.beam + 1).filter(|&k| k < ranges.len()));
+    Some([
+        nf,
+        std_dev,
+        avg_median_dev,
+        width,
+        linearity,
+        circularity,
+        0.0,
+        boundary,
+        boundary_regularity,
+        curvature,
+        ang_diff,
+        iav,
+        std_iav,
+        distance,
+        distance / nf,
+        occluded_right,
+        occluded_left,
+    ])
+}

@@ -15,6 +15,12 @@
 //!    person from [`crate::track::kalman`], global nearest neighbour with a Mahalanobis gate
 //!    through [`crate::assign`], M-of-N initiation and deletion, single-leg updates).
 //!
+//! [`occupancy`] is leg_tracker's local occupancy grid (the scans mapped in the fixed frame,
+//! tracked people left out); [`joint`] is leg_tracker's joint leg tracker (every cluster
+//! tracked, leg pairs that move together through free space become people); [`people`] holds
+//! the two together (`FreeSpaceTracker`). [`scan_match`] estimates the laser's motion from its
+//! scans (point-to-line ICP) for logs without odometry, so that the grid has a fixed frame.
+//!
 //! [`follow`] is seed 001's single-target follower: blobs, their colour likelihood in the omni
 //! image ([`crate::vision::cylinder`]) and a PDAF ([`crate::track::pdaf`]) with the `rst` rule.
 //!
@@ -29,11 +35,17 @@
 pub mod circle;
 pub mod features;
 pub mod follow;
+pub mod joint;
 pub mod legs;
+pub mod occupancy;
+pub mod people;
 pub mod points;
+pub mod scan_match;
 pub mod segment;
 pub mod tracker;
 pub mod training;
 
+#[cfg(test)]
+mod joint_tests;
 #[cfg(test)]
 mod tests;

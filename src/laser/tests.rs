@@ -8,7 +8,10 @@ use super::features::{self, RADIUS_CAP};
 use super::legs::{self, LegParams};
 use super::points::{self, ScanGeometry, ScanPoint};
 use super::segment::{self, SegmentOptions, Threshold};
-use super::tracker::{Association, JpdaParams, PeopleTracker, TrackerParams, Update};
+use super::tracker::{
+    Association, Confirmation, JpdaParams, MotionParams, Observation, PeopleTracker, TrackerParams,
+    Update,
+};
 
 fn beams(segs: &[segment::Segment]) -> Vec<(usize, usize)> {
     segs.iter().map(|s| (s.first_beam, s.last_beam)).collect()
@@ -162,13 +165,13 @@ fn the_tracker_filter_matches_the_closed_form_for_one_step() {
 
 /// A synthetic scanner at the origin: 512 beams over ±90° (0.35°), 10 m range, a wall at
 /// x = 8 m, and legs as circles.
-struct Synth {
-    geometry: ScanGeometry,
-    beams: usize,
+pub(super) struct Synth {
+    pub(super) geometry: ScanGeometry,
+    pub(super) beams: usize,
 }
 
 impl Synth {
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         let inc = std::f64::consts::PI / 511.0;
         Synth {
             geometry: ScanGeometry {
@@ -181,7 +184,7 @@ impl Synth {
         }
     }
 
-    fn ranges(&self, circles: &[(Point2<f64>, f64)]) -> Vec<f32> {
+    pub(super) fn ranges(&self, circles: &[(Point2<f64>, f64)]) -> Vec<f32> {
         (0..self.beams)
             .map(|k| {
                 let th = self.geometry.angle(k);
@@ -219,7 +222,10 @@ impl Synth {
 }
 
 /// Two legs of radius 0.06 m, 0.1 m either side of `centre` across the walking direction.
-fn legs_of(centre: Point2<f64>, heading: nalgebra::Vector2<f64>) -> [(Point2<f64>, f64); 2] {
+pub(super) fn legs_of(
+    centre: Point2<f64>,
+    heading: nalgebra::Vector2<f64>,
+) -> [(Point2<f64>, f64); 2] {
     let n = nalgebra::Vector2::new(-heading.y, heading.x) * 0.1;
     [(centre + n, 0.06), (centre - n, 0.06)]
 }
@@ -565,4 +571,191 @@ fn detection_and_tracking_run_over_a_real_log() {
     assert_eq!(n, 200);
     assert_eq!(frames.fixed_frame(), Some("odom"));
     assert!(!ids.is_empty());
+}
+
+fn motion() -> TrackerParams {
+    TrackerParams {
+        confirmation: Confirmation::Motion(MotionParams::default()),
+        ..TrackerParams::default()
+    }
+}
+
+fn at(x: f64, y: f64, occupancy: f64) -> Observation {
+    Observation {
+        position: Point2::new(x, y),
+        confidence: 1.0,
+        occupancy,
+    }
+}
+
+/// A person standing still in free space, seen on every scan: M-of-N reports it from the
+/// third scan, motion confirmation never (it has not moved).
+#[test]
+fn a_still_pair_is_confirmed_by_m_of_n_but_not_by_motion() {
+    let mut mofn = PeopleTracker::new(TrackerParams::default());
+    let mut mot = PeopleTracker::new(motion());
+    for i in 0..30 {
+        let time = f64::from(i) * 0.1;
+        mofn.step_observed(time, &[at(2.0, 0.0, 0.0)], &[]);
+        mot.step_observed(time, &[at(2.0, 0.0, 0.0)], &[]);
+        assert_eq!(mofn.confirmed().count(), usize::from(i >= 2), "scan {i}");
+        assert_eq!(mot.confirmed().count(), 0, "scan {i}");
+    }
+    assert_eq!(mot.tracks().len(), 1);
+    assert_eq!(mot.tracks()[0].travelled_m, 0.0);
+}
+
+/// A person walking at 1 m/s through free space: the distance travelled is exactly the sum of
+/// the filtered position's steps longer than 1 cm, and the track is reported on the first scan
+/// where that sum reaches 0.5 m. The same walk through occupied space is never reported.
+#[test]
+fn motion_confirmation_counts_the_filtered_steps_through_free_space() {
+    let mut t = PeopleTracker::new(motion());
+    let mut occupied = PeopleTracker::new(motion());
+    let (mut sum, mut prev) = (0.0, None::<Point2<f64>>);
+    let mut first_confirmed = None;
+    for i in 0..20 {
+        let time = f64::from(i) * 0.1;
+        let x = 1.0 + 0.1 * f64::from(i);
+        t.step_observed(time, &[at(x, 0.0, 0.01)], &[]);
+        occupied.step_observed(time, &[at(x, 0.0, 0.5)], &[]);
+        assert_eq!(occupied.confirmed().count(), 0);
+        let tr = &t.tracks()[0];
+        if let Some(p) = prev {
+            let step = (tr.position() - p).norm();
+            if step > 0.01 {
+                sum += step;
+            }
+        }
+        prev = Some(tr.position());
+        assert!((tr.travelled_m - sum).abs() < 1e-12, "scan {i}");
+        assert_eq!(tr.confirmed, sum >= 0.5, "scan {i}: {sum}");
+        if tr.confirmed && first_confirmed.is_none() {
+            first_confirmed = Some(i);
+        }
+    }
+    // the filter starts at rest and catches up: 0.5 m takes more than 5 scans, fewer than 10
+    let k = first_confirmed.expect("confirmed");
+    assert!((5..10).contains(&k), "{k}");
+    assert_eq!(t.tracks().len(), 1);
+}
+
+/// A person whose legs pair on one scan in three: M-of-N (3 of 5, at most 2 early misses)
+/// keeps deleting and restarting the track and never reports it; motion confirmation keeps one
+/// track (deleted only after 10 scans without update) and reports it once it has walked 0.5 m.
+#[test]
+fn a_briefly_paired_walker_is_reported_by_motion_not_by_m_of_n() {
+    let run = |params: TrackerParams| {
+        let mut t = PeopleTracker::new(params);
+        let mut reported = 0;
+        for i in 0..40 {
+            let time = f64::from(i) * 0.1;
+            let x = 1.0 + 0.1 * f64::from(i);
+            let seen = if i % 3 == 0 {
+                vec![at(x, 0.0, 0.0)]
+            } else {
+                vec![]
+            };
+            t.step_observed(time, &seen, &[]);
+            reported = reported.max(t.confirmed().count());
+        }
+        (reported, t.tracks().iter().map(|tr| tr.id).max())
+    };
+    let (mofn, _) = run(TrackerParams::default());
+    assert_eq!(mofn, 0);
+    let (mot, last_id) = run(motion());
+    assert_eq!(mot, 1);
+    assert_eq!(last_id, Some(1), "one track all along");
+}
+
+/// A confirmed track whose person vanishes next to a static leg-like object: under M-of-N the
+/// track takes the object's observations and lives on; under motion confirmation the object
+/// lies in occupied space, the track takes none of them (pairs or single legs) and is deleted
+/// after 10 scans without update.
+#[test]
+fn confirmed_tracks_take_no_observation_outside_free_space() {
+    let run = |params: TrackerParams| {
+        let mut t = PeopleTracker::new(params);
+        let mut alive = Vec::new();
+        for i in 0..40 {
+            let time = f64::from(i) * 0.1;
+            let (people, legs) = if i < 15 {
+                (vec![at(1.0 + 0.1 * f64::from(i), 0.0, 0.0)], vec![])
+            } else {
+                // a pole at the track's last position: a pair on odd scans, a leg on even ones
+                let pole = at(2.45, 0.05, 0.8);
+                if i % 2 == 1 {
+                    (vec![pole], vec![])
+                } else {
+                    (vec![], vec![pole])
+                }
+            };
+            t.step_observed(time, &people, &legs);
+            alive.push(t.confirmed().any(|tr| tr.id == 1));
+        }
+        alive
+    };
+    let mofn = run(TrackerParams::default());
+    assert!(mofn[2..].iter().all(|&a| a), "{mofn:?}");
+    let mot = run(motion());
+    assert!(mot[10..24].iter().all(|&a| a), "{mot:?}");
+    assert!(mot[25..].iter().all(|&a| !a), "{mot:?}");
+}
+
+/// leg_tracker's features of four collinear points 0.1 m apart at x = 1, worked by hand from
+/// its formulas (quirks included: `boundary_regularity` divides by `n`, so equal steps give
+/// 0.05, not 0; `radius` is 0): the left neighbour (beam 9, 3 m) is farther (not occluded),
+/// the right one (beam 14) has no return (occluded stays 1).
+#[test]
+fn leg_tracker_features_of_a_short_line_match_the_hand_computation() {
+    let pts = scan_points(
+        10,
+        &[
+            Point2::new(1.0, -0.15),
+            Point2::new(1.0, -0.05),
+            Point2::new(1.0, 0.05),
+            Point2::new(1.0, 0.15),
+        ],
+    );
+    let mut ranges = vec![f32::NAN; 20];
+    ranges[9] = 3.0;
+    for p in &pts {
+        ranges[p.beam] = p.range as f32;
+    }
+    let g = ScanGeometry {
+        angle_min: -0.5,
+        angle_increment: 0.05,
+        range_min: 0.05,
+        range_max: 10.0,
+    };
+    let f = features::leg_tracker_features(&pts, &whole(&pts), &g, &ranges).expect("4 points");
+    let pi = std::f64::consts::PI;
+    let want = [
+        4.0,
+        (0.05f64 / 3.0).sqrt(),
+        0.1,
+        0.3,
+        0.0,
+        0.0,
+        0.0,
+        0.3,
+        0.05,
+        0.0,
+        pi / 2.0,
+        pi / 2.0,
+        pi / 3f64.sqrt(),
+        1.0,
+        0.25,
+        1.0,
+        0.0,
+    ];
+    for (k, (a, b)) in f.iter().zip(want).enumerate() {
+        assert!(
+            (a - b).abs() < 1e-9,
+            "{}: {a} vs {b}",
+            features::LEG_TRACKER_FEATURE_NAMES[k]
+        );
+    }
+    let two = &pts[..2];
+    assert!(features::leg_tracker_features(two, &whole(two), &g, &ranges).is_none());
 }

@@ -23,6 +23,21 @@
 //!    before that; a confirmed track is deleted when it was updated in fewer than `delete_m`
 //!    of its last `delete_n` scans.
 //!
+//! **Motion confirmation** ([`Confirmation::Motion`], instead of step 5's M-of-N; leg_tracker's
+//! rule, Leigh et al. ICRA 2015, `joint_leg_tracker.py`): observations carry the detector's
+//! confidence and the occupancy of the space around them ([`Observation`], from
+//! [`crate::laser::occupancy`]). A tentative track is reported as a person once it has
+//! travelled `min_travel_m` through free space — the sum of its filtered position's steps
+//! between updates (each from the position after the previous update) longer than
+//! `min_step_m`, counted on updates whose observation had occupancy below `free_threshold` —
+//! and the mean confidence of its observations reaches `min_confidence`. Confirmed tracks
+//! take no observation (pair or single leg) whose occupancy is at or above `free_threshold`
+//! (leg_tracker: "ignore possible matchings between people and detections not in free space"),
+//! so a person's track cannot pass on to a static leg-like object. Tentative tracks are deleted
+//! by the confirmed tracks' rule (`delete_m` of `delete_n`), not by the early-miss count, so a
+//! person whose legs are paired only now and then keeps a track while it moves. With JPDA the
+//! free-space gate applies to the single legs only.
+//!
 //! Ids are 1, 2, 3, … in order of creation; within a scan new tracks are created in
 //! observation order, so the same input gives the same ids.
 //!
@@ -87,6 +102,65 @@ impl Default for JpdaParams {
 /// 0.948, 0.954 for 3, 5, 10, 20 scans against 0.953 without a limit), never on the real logs.
 pub const LEG_ONLY_SCANS: usize = 20;
 
+/// How a tentative track becomes a reported person (see the module doc).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Confirmation {
+    /// `confirm_m` of the last `confirm_n` scans updated (the default).
+    MofN,
+    /// Travelled far enough through free space, with enough detector confidence.
+    Motion(MotionParams),
+}
+
+/// Parameters of [`Confirmation::Motion`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MotionParams {
+    /// Distance (m) travelled through free space before a track is reported.
+    pub min_travel_m: f64,
+    /// Steps of the filtered position shorter than this (m) are not counted.
+    pub min_step_m: f64,
+    /// An observation lies in free space when its occupancy is below this.
+    pub free_threshold: f64,
+    /// Least mean detector confidence of a track's observations to be reported.
+    pub min_confidence: f64,
+}
+
+impl Default for MotionParams {
+    /// leg_tracker's values (`joint_leg_tracker.py` defaults, kept by the benchmark launch
+    /// files): `min_travel_m` 0.5 (`dist_travelled_together_to_initiate_leg_pair`),
+    /// `min_step_m` 0.01 (its `delta_dist_travelled > 0.01`), `free_threshold` 0.06
+    /// (`in_free_space_threshold`); `min_confidence` 0 (off: the leg model has no confidence).
+    fn default() -> Self {
+        MotionParams {
+            min_travel_m: 0.5,
+            min_step_m: 0.01,
+            free_threshold: 0.06,
+            min_confidence: 0.0,
+        }
+    }
+}
+
+/// One observation with what the detector and the occupancy grid say of it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Observation {
+    /// Fixed frame (m).
+    pub position: Point2<f64>,
+    /// Detector confidence in `[0, 1]` (1 for the leg model).
+    pub confidence: f64,
+    /// Occupancy of the space around it (0: free; [`crate::laser::occupancy::LocalGrid::occupancy_around`]).
+    pub occupancy: f64,
+}
+
+impl Observation {
+    /// A position with confidence 1 in free space (what [`PeopleTracker::step`] assumes).
+    pub fn certain(position: Point2<f64>) -> Self {
+        Observation {
+            position,
+            confidence: 1.0,
+            occupancy: 0.0,
+        }
+    }
+}
+
 /// Tracker parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrackerParams {
@@ -109,6 +183,8 @@ pub struct TrackerParams {
     /// Single legs are offered only to tracks that had a leg-pair update within their last
     /// this many scans; `None`: always (the default).
     pub max_leg_only_scans: Option<usize>,
+    /// How tentative tracks are confirmed (M-of-N by default).
+    pub confirmation: Confirmation,
 }
 
 impl Default for TrackerParams {
@@ -137,6 +213,7 @@ impl Default for TrackerParams {
             delete_n: 10,
             association: Association::Gnn,
             max_leg_only_scans: None,
+            confirmation: Confirmation::MofN,
         }
     }
 }
@@ -165,6 +242,15 @@ pub struct Track {
     /// Scans since the last leg-pair (people observation) update.
     pub since_pair: usize,
     pub last: Update,
+    /// Distance travelled through free space (m; counted under [`Confirmation::Motion`]).
+    pub travelled_m: f64,
+    /// Sum of the confidences of its observations and their count.
+    pub confidence_sum: f64,
+    pub observations: usize,
+    /// Position after the last scan that updated it.
+    previous: Point2<f64>,
+    /// Occupancy of the observation that last updated it.
+    last_occupancy: f64,
 }
 
 impl Track {
@@ -176,6 +262,15 @@ impl Track {
         Vector2::new(self.filter.x[2], self.filter.x[3])
     }
 
+    /// Mean detector confidence of its observations.
+    pub fn mean_confidence(&self) -> f64 {
+        if self.observations == 0 {
+            0.0
+        } else {
+            self.confidence_sum / self.observations as f64
+        }
+    }
+
     fn hits(&self, last_n: usize) -> usize {
         self.history
             .iter()
@@ -184,6 +279,14 @@ impl Track {
             .filter(|&&h| h)
             .count()
     }
+}
+
+/// Count an observation that updated `t`: its confidence, and under motion confirmation the
+/// step of the filtered position when the observation lies in free space (module doc).
+fn note_observation(t: &mut Track, z: &Observation) {
+    t.confidence_sum += z.confidence;
+    t.observations += 1;
+    t.last_occupancy = z.occupancy;
 }
 
 /// The tracker's state (see the module doc).
@@ -244,6 +347,14 @@ impl PeopleTracker {
     /// One scan at `time_s` (seconds, any origin) with its people observations and unpaired
     /// legs, both in the fixed frame. Non-finite observations are ignored.
     pub fn step(&mut self, time_s: f64, people: &[Point2<f64>], legs: &[Point2<f64>]) {
+        let people: Vec<Observation> = people.iter().map(|&p| Observation::certain(p)).collect();
+        let legs: Vec<Observation> = legs.iter().map(|&p| Observation::certain(p)).collect();
+        self.step_observed(time_s, &people, &legs);
+    }
+
+    /// [`Self::step`] with each observation's confidence and occupancy (used by
+    /// [`Confirmation::Motion`]; the M-of-N tracker ignores them).
+    pub fn step_observed(&mut self, time_s: f64, people: &[Observation], legs: &[Observation]) {
         let dt = match self.last_time {
             Some(t0) if (time_s - t0).is_finite() && time_s > t0 => time_s - t0,
             _ => 0.0,
@@ -257,22 +368,29 @@ impl PeopleTracker {
             t.filter.predict(&f, &q);
             t.last = Update::Missed;
         }
-        let finite = |z: &&Point2<f64>| z.x.is_finite() && z.y.is_finite();
+        let finite = |z: &Point2<f64>| z.x.is_finite() && z.y.is_finite();
         let r_person = Matrix2::identity() * p.person_sigma.powi(2);
         let r_leg = Matrix2::identity() * p.leg_sigma.powi(2);
+        let people_at: Vec<Point2<f64>> = people.iter().map(|o| o.position).collect();
+        let legs_at: Vec<Point2<f64>> = legs.iter().map(|o| o.position).collect();
 
         let all: Vec<usize> = (0..self.tracks.len()).collect();
         let mut person_used = vec![false; people.len()];
         let mut soft = vec![false; self.tracks.len()];
         match p.association {
             Association::Gnn => {
-                for (ti, zi) in self.associate(&all, people, &r_person) {
+                for (ti, zi) in self.associate(&all, &people_at, people, &r_person) {
                     person_used[zi] = true;
                     self.apply(ti, &r_person, &people[zi], Update::Person(zi));
                 }
             }
             Association::Jpda(j) => {
-                self.jpda(people, &r_person, &j, &mut person_used, &mut soft);
+                self.jpda(&people_at, &r_person, &j, &mut person_used, &mut soft);
+                for (ti, t) in self.tracks.iter_mut().enumerate() {
+                    if let (true, Update::Person(zi)) = (soft[ti], t.last) {
+                        note_observation(t, &people[zi]);
+                    }
+                }
             }
         }
         let unmatched: Vec<usize> = all
@@ -284,14 +402,23 @@ impl PeopleTracker {
                     .is_none_or(|k| self.tracks[ti].since_pair < k)
             })
             .collect();
-        for (ti, zi) in self.associate(&unmatched, legs, &r_leg) {
+        for (ti, zi) in self.associate(&unmatched, &legs_at, legs, &r_leg) {
             self.apply(ti, &r_leg, &legs[zi], Update::Leg(zi));
         }
         self.book_keep();
         for (zi, z) in people.iter().enumerate() {
-            if !person_used[zi] && finite(&z) {
+            if !person_used[zi] && finite(&z.position) {
                 self.start(zi, z);
             }
+        }
+    }
+
+    /// Whether a confirmed track may take an observation of this occupancy (the free-space
+    /// gate of [`Confirmation::Motion`]).
+    fn may_take(&self, ti: usize, occupancy: f64) -> bool {
+        match self.params.confirmation {
+            Confirmation::MofN => true,
+            Confirmation::Motion(m) => !self.tracks[ti].confirmed || occupancy < m.free_threshold,
         }
     }
 
@@ -300,12 +427,16 @@ impl PeopleTracker {
         &self,
         candidates: &[usize],
         obs: &[Point2<f64>],
+        meta: &[Observation],
         r: &Matrix2<f64>,
     ) -> Vec<(usize, usize)> {
         let gate = self.params.gate;
         max_score_pairs(candidates.len(), obs.len(), |i, j| {
             let z = &obs[j];
-            if !(z.x.is_finite() && z.y.is_finite()) {
+            if !(z.x.is_finite()
+                && z.y.is_finite()
+                && self.may_take(candidates[i], meta[j].occupancy))
+            {
                 return f64::NAN;
             }
             let d2 = mahalanobis2(&self.tracks[candidates[i]].filter, r, z);
@@ -366,9 +497,10 @@ impl PeopleTracker {
             let sub: Vec<Point2<f64>> = zs.iter().map(|&z| people[z]).collect();
             let Some(m) = joint_marginals(&w, &vec![miss; ts.len()], j.max_events) else {
                 self.jpda_fallbacks += 1;
-                for (ti, k) in self.associate(&ts, &sub, r) {
+                let meta: Vec<Observation> = sub.iter().map(|&z| Observation::certain(z)).collect();
+                for (ti, k) in self.associate(&ts, &sub, &meta, r) {
                     used[zs[k]] = true;
-                    self.apply(ti, r, &sub[k], Update::Person(zs[k]));
+                    self.apply(ti, r, &meta[k], Update::Person(zs[k]));
                 }
                 continue;
             };
@@ -385,10 +517,11 @@ impl PeopleTracker {
         }
     }
 
-    fn apply(&mut self, ti: usize, r: &Matrix2<f64>, z: &Point2<f64>, how: Update) {
+    fn apply(&mut self, ti: usize, r: &Matrix2<f64>, z: &Observation, how: Update) {
         let t = &mut self.tracks[ti];
-        if t.filter.update(&h(), r, &z.coords).is_ok() {
+        if t.filter.update(&h(), r, &z.position.coords).is_ok() {
             t.last = how;
+            note_observation(t, z);
         }
     }
 
@@ -406,17 +539,31 @@ impl PeopleTracker {
             while t.history.len() > keep {
                 t.history.pop_front();
             }
+            let now = t.position();
+            if let Confirmation::Motion(m) = p.confirmation {
+                let step = (now - t.previous).norm();
+                if hit && t.last_occupancy < m.free_threshold && step > m.min_step_m {
+                    t.travelled_m += step;
+                }
+            }
             if !t.confirmed {
                 if !hit {
                     t.early_misses += 1;
                 }
-                if t.hits(p.confirm_n) >= p.confirm_m {
-                    t.confirmed = true;
-                }
+                t.confirmed = match p.confirmation {
+                    Confirmation::MofN => t.hits(p.confirm_n) >= p.confirm_m,
+                    Confirmation::Motion(m) => {
+                        t.travelled_m >= m.min_travel_m && t.mean_confidence() >= m.min_confidence
+                    }
+                };
+            }
+            if hit {
+                t.previous = now;
             }
         }
+        let motion = matches!(p.confirmation, Confirmation::Motion(_));
         self.tracks.retain(|t| {
-            if t.confirmed {
+            if t.confirmed || motion {
                 t.history.len() < p.delete_n || t.hits(p.delete_n) >= p.delete_m
             } else {
                 t.early_misses <= p.confirm_n.saturating_sub(p.confirm_m)
@@ -424,22 +571,31 @@ impl PeopleTracker {
         });
     }
 
-    fn start(&mut self, zi: usize, z: &Point2<f64>) {
+    fn start(&mut self, zi: usize, z: &Observation) {
         let p = self.params;
         let pos = p.person_sigma.powi(2);
         let vel = p.init_velocity_sigma.powi(2);
         let cov = Matrix4::from_diagonal(&Vector4::new(pos, pos, vel, vel));
         let mut history = VecDeque::new();
         history.push_back(true);
-        let confirmed = p.confirm_m <= 1;
+        let confirmed = match p.confirmation {
+            Confirmation::MofN => p.confirm_m <= 1,
+            Confirmation::Motion(m) => m.min_travel_m <= 0.0 && z.confidence >= m.min_confidence,
+        };
+        let at = z.position;
         self.tracks.push(Track {
             id: self.next_id,
             confirmed,
-            filter: Kalman::new(Vector4::new(z.x, z.y, 0.0, 0.0), cov),
+            filter: Kalman::new(Vector4::new(at.x, at.y, 0.0, 0.0), cov),
             history,
             early_misses: 0,
             since_pair: 0,
             last: Update::Person(zi),
+            travelled_m: 0.0,
+            confidence_sum: z.confidence,
+            observations: 1,
+            previous: at,
+            last_occupancy: z.occupancy,
         });
         self.next_id += 1;
     }

@@ -29,7 +29,9 @@
 
 use nalgebra::Point2;
 
-use super::features::{self, FEATURE_NAMES};
+use serde::{Deserialize, Serialize};
+
+use super::features::{self, FEATURE_NAMES, LEG_TRACKER_FEATURE_NAMES};
 use super::points::{self, ScanGeometry, ScanPoint};
 use super::segment::{self, Segment, SegmentOptions};
 
@@ -46,6 +48,39 @@ pub fn sample_feature_names() -> Vec<&'static str> {
     let mut v = FEATURE_NAMES.to_vec();
     v.push("range");
     v
+}
+
+/// Which features a sample carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FeatureSet {
+    /// The 11 features of [`features::compute`] and the centroid's range (12).
+    #[default]
+    Segment,
+    /// leg_tracker's 17 cluster features ([`features::leg_tracker_features`]).
+    LegTracker,
+}
+
+impl FeatureSet {
+    /// The names, in vector order.
+    pub fn names(self) -> Vec<&'static str> {
+        match self {
+            FeatureSet::Segment => sample_feature_names(),
+            FeatureSet::LegTracker => LEG_TRACKER_FEATURE_NAMES.to_vec(),
+        }
+    }
+
+    /// The feature vector of segment `i` of a segmented scan (`None`: the set is undefined on
+    /// it, e.g. leg_tracker's on fewer than 3 points).
+    pub fn of(self, s: &Segmented, i: usize) -> Option<Vec<f64>> {
+        match self {
+            FeatureSet::Segment => Some(sample_features(s, i)),
+            FeatureSet::LegTracker => {
+                features::leg_tracker_features(&s.points, &s.segments[i], &s.geometry, &s.ranges)
+                    .map(|f| f.to_vec())
+            }
+        }
+    }
 }
 
 /// Why a training file does not parse.
@@ -160,11 +195,14 @@ pub fn parse_legs(text: &str, file: &str) -> Result<Vec<(usize, Point2<f64>)>, T
         .collect()
 }
 
-/// A scan's returns, segments (default options) and each segment's sensor-frame centroid.
+/// A scan's returns, segments (default options) and each segment's sensor-frame centroid,
+/// with the ranges and beam geometry they came from.
 pub struct Segmented {
     pub points: Vec<ScanPoint>,
     pub segments: Vec<Segment>,
     pub centroids: Vec<Point2<f64>>,
+    pub geometry: ScanGeometry,
+    pub ranges: Vec<f32>,
 }
 
 /// Project and segment one scan (sensor frame).
@@ -176,6 +214,8 @@ pub fn segment_scan(ranges: &[f32], geometry: &ScanGeometry) -> Segmented {
         points,
         segments,
         centroids,
+        geometry: *geometry,
+        ranges: ranges.to_vec(),
     }
 }
 
@@ -225,6 +265,7 @@ pub fn positive_samples(
     group: &str,
     scans: &[ScanRecord],
     labels: &[(usize, Point2<f64>)],
+    set: FeatureSet,
 ) -> (Vec<Sample>, usize) {
     let mut out = Vec::new();
     let mut unmatched = 0;
@@ -243,10 +284,13 @@ pub fn positive_samples(
             .len()
             .saturating_sub(hit.iter().filter(|&&h| h).count());
         for (i, _) in hit.iter().enumerate().filter(|(_, h)| **h) {
+            let Some(features) = set.of(&s, i) else {
+                continue;
+            };
             out.push(Sample {
                 group: group.to_string(),
                 scan_idx: scan.scan_idx,
-                features: sample_features(&s, i),
+                features,
                 range_m: s.centroids[i].coords.norm(),
                 leg: true,
             });
@@ -257,17 +301,24 @@ pub fn positive_samples(
 
 /// Negative samples of a people-free file: every `keep_every`-th segment in file order (≥ 1),
 /// grouped by file and laser (`group/frame_id`).
-pub fn negative_samples(group: &str, scans: &[ScanRecord], keep_every: usize) -> Vec<Sample> {
+pub fn negative_samples(
+    group: &str,
+    scans: &[ScanRecord],
+    keep_every: usize,
+    set: FeatureSet,
+) -> Vec<Sample> {
     let mut out = Vec::new();
     let mut k = 0usize;
     for scan in scans {
         let s = segment_scan(&scan.ranges, &scan.geometry);
         for i in 0..s.segments.len() {
-            if k.is_multiple_of(keep_every.max(1)) {
+            if k.is_multiple_of(keep_every.max(1))
+                && let Some(features) = set.of(&s, i)
+            {
                 out.push(Sample {
                     group: format!("{group}/{}", scan.frame_id),
                     scan_idx: scan.scan_idx,
-                    features: sample_features(&s, i),
+                    features,
                     range_m: s.centroids[i].coords.norm(),
                     leg: false,
                 });
@@ -393,17 +444,30 @@ mod tests {
             geometry: g,
             ranges: ranges.clone(),
         }];
-        let (pos, unmatched) = positive_samples("p1", &scans, &[(7, label), (7, far), (8, label)]);
+        let (pos, unmatched) = positive_samples(
+            "p1",
+            &scans,
+            &[(7, label), (7, far), (8, label)],
+            FeatureSet::Segment,
+        );
         assert_eq!(unmatched, 1);
         assert_eq!(pos.len(), 1);
         assert_eq!(pos[0].features[0], 4.0); // four points
         assert_eq!(pos[0].features.len(), sample_feature_names().len());
         // negatives: both segments, then every second one
-        assert_eq!(negative_samples("n", &scans, 1).len(), 2);
-        let half = negative_samples("n", &scans, 2);
+        assert_eq!(
+            negative_samples("n", &scans, 1, FeatureSet::Segment).len(),
+            2
+        );
+        let half = negative_samples("n", &scans, 2, FeatureSet::Segment);
         assert_eq!(half.len(), 1);
         assert_eq!(half[0].group, "n/l");
         assert_eq!(half[0].features[0], 10.0); // the wall came first
+        // leg_tracker's set: 17 features, the point count first
+        let lt = negative_samples("n", &scans, 1, FeatureSet::LegTracker);
+        assert_eq!(lt.len(), 2);
+        assert_eq!(lt[1].features.len(), 17);
+        assert_eq!(lt[1].features[0], 4.0);
     }
 
     #[test]

@@ -128,6 +128,41 @@ pub struct Scatter {
     pub keep_clear: Vec<[f64; 3]>,
 }
 
+/// Leg-like clutter for laser scenes (`[world.clutter]`; see `synth::world::clutter`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Clutter {
+    /// Where it stands `[x0, y0, x1, y1]`.
+    pub area: [f64; 4],
+    /// Thin vertical poles and their radius range (m).
+    #[serde(default)]
+    pub poles: u32,
+    #[serde(default = "default_pole_radius")]
+    pub pole_radius: [f64; 2],
+    /// Tree trunks (no crown) and their radius range (m).
+    #[serde(default)]
+    pub trunks: u32,
+    #[serde(default = "default_trunk_radius")]
+    pub trunk_radius: [f64; 2],
+    /// Tables on four legs, chairs on four legs, walls with one or two gaps.
+    #[serde(default)]
+    pub tables: u32,
+    #[serde(default)]
+    pub chairs: u32,
+    #[serde(default)]
+    pub walls: u32,
+    /// Discs `[x, y, r]` kept free.
+    #[serde(default)]
+    pub keep_clear: Vec<[f64; 3]>,
+}
+
+fn default_pole_radius() -> [f64; 2] {
+    [0.015, 0.05]
+}
+fn default_trunk_radius() -> [f64; 2] {
+    [0.08, 0.2]
+}
+
 /// An opening people enter and leave by (a darker rectangle on the wall).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -230,6 +265,9 @@ pub struct World {
     #[serde(default)]
     pub boxes: Vec<BoxSpec>,
     pub scatter: Option<Scatter>,
+    /// Leg-like clutter for laser scenes (absent: none).
+    #[serde(default)]
+    pub clutter: Option<Clutter>,
     #[serde(default)]
     pub doors: Vec<Door>,
     #[serde(default)]
@@ -375,6 +413,9 @@ pub struct Crowd {
     /// the robot and them (`synth::motion::jog::companion`).
     #[serde(default)]
     pub companions: u32,
+    /// Leg radius range (m) of the crowd's people; absent: 0.055–0.075.
+    #[serde(default)]
+    pub leg_radius: Option<[f64; 2]>,
 }
 
 fn default_heights() -> [f64; 2] {

@@ -12,6 +12,8 @@ use super::scenario::{
 use super::shapes::Shape;
 use crate::rng;
 
+mod clutter;
+
 /// Object ids: 0 is static background, 1..PERSON_BASE moving background, PERSON_BASE + id a person.
 pub const PERSON_BASE: u32 = 1000;
 
@@ -657,6 +659,10 @@ impl World {
         if let Some(sc) = &w.scatter {
             let r = rng::stream(s.scenario.seed, "scatter", session);
             push_scatter(sc, w.size, r, &mut statics, &mut obstacles);
+        }
+        if let Some(c) = &w.clutter {
+            let r = rng::stream(s.scenario.seed, "clutter", session);
+            clutter::push_clutter(c, r, &mut statics, &mut obstacles);
         }
         let moving = moving_background(s, session, &mut statics);
         let sun = if w.kind == WorldKind::Outdoor {

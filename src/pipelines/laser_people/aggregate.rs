@@ -9,6 +9,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use super::classifier;
+use super::fp_causes::{self, FpCauseRow};
 use super::methods::Method;
 use super::params::{Params, Sequence};
 use super::tables::{self, ScanRow, SessionRow, TrackRow, TruthRow};
@@ -74,6 +75,10 @@ table_row! {
         pub fixed_frame: String,
         pub scans: i64,
         pub unposed: i64,
+        pub odometry: String,
+        pub scan_match_failures: i64,
+        pub odometry_rpe_m: f64,
+        pub odometry_rpe_deg: f64,
         pub gt_rows: i64,
         pub gt_dropped: i64,
         pub skipped_messages: i64,
@@ -100,10 +105,12 @@ fn point(frame: i64, id: i64, x: f64, y: f64) -> Observation {
     }
 }
 
-/// Scores of one detector and its match distances by (scan, ground-truth id).
+/// Scores of one detector, its match distances by (scan, ground-truth id) and the causes of
+/// its false positives.
 struct Scored {
     row: ResultRow,
     errors: BTreeMap<(i64, i64), f64>,
+    causes: FpCauseRow,
 }
 
 fn score(d: &SessionData, seq: &Sequence, detector: &str, match_m: f64) -> anyhow::Result<Scored> {
@@ -128,6 +135,28 @@ fn score(d: &SessionData, seq: &Sequence, detector: &str, match_m: f64) -> anyho
         .filter(|e| matches!(e.kind, EventKind::Match | EventKind::Switch))
         .filter_map(|e| Some(((e.frame, e.gt_id?), e.distance?)))
         .collect();
+    let fps: Vec<(i64, i64)> = ev
+        .events
+        .iter()
+        .filter(|e| e.kind == EventKind::FalsePositive)
+        .filter_map(|e| Some((e.frame, e.hyp_id?)))
+        .collect();
+    let scored_truth: Vec<&TruthRow> = d
+        .truth
+        .iter()
+        .filter(|r| keep(r.scan_idx, r.x, r.y))
+        .collect();
+    let blank = FpCauseRow {
+        dataset: d.dataset.clone(),
+        sequence: d.name.clone(),
+        detector: detector.into(),
+        false_positives: 0,
+        unannotated_scan: 0,
+        near_person: 0,
+        static_track: 0,
+        other: 0,
+    };
+    let causes = fp_causes::classify(blank, &fps, &scored_truth, &d.tracks, match_m);
     let m = &ev.metrics;
     let scored = d
         .scans
@@ -149,7 +178,11 @@ fn score(d: &SessionData, seq: &Sequence, detector: &str, match_m: f64) -> anyho
         misses: Some(m.clear.num_misses as i64),
         id_switches: Some(m.clear.num_switches as i64),
     };
-    Ok(Scored { row, errors })
+    Ok(Scored {
+        row,
+        errors,
+        causes,
+    })
 }
 
 fn ttest(d: &SessionData, first: &Scored, second: &Scored, level: f64) -> TTestRow {
@@ -261,6 +294,7 @@ pub(super) fn run(
     let mut out = Products::default();
     let (active, skipped_methods) = split_methods(p);
     let (mut results, mut tests, mut sessions) = (Vec::new(), Vec::new(), Vec::new());
+    let mut causes = Vec::new();
     for d in &data {
         let seq = p.sequence(&d.name);
         let scored: Vec<Scored> = active
@@ -292,6 +326,7 @@ pub(super) fn run(
                 ));
             }
         }
+        causes.extend(scored.iter().map(|s| s.causes.clone()));
         results.extend(scored.into_iter().map(|s| s.row));
         for m in &active {
             out.artifacts.push((
@@ -308,6 +343,10 @@ pub(super) fn run(
             fixed_frame: s.fixed_frame.clone(),
             scans: s.scans,
             unposed: s.unposed,
+            odometry: s.odometry.clone(),
+            scan_match_failures: s.scan_match_failures,
+            odometry_rpe_m: s.odometry_rpe_m,
+            odometry_rpe_deg: s.odometry_rpe_deg,
             gt_rows: s.gt_rows,
             gt_dropped: s.gt_dropped,
             skipped_messages: s.skipped_messages,
@@ -324,6 +363,19 @@ pub(super) fn run(
         }
     }
     push_tables(&mut out, p, &results, &tests, &sessions)?;
+    out.tables.push(
+        Table::new(
+            "fp_causes",
+            "False positives by cause, per sequence and method (the first cause that applies)",
+            FpCauseRow::frame(&causes)?,
+        )
+        .with_note(format!(
+            "unannotated_scan: no scored ground truth on the scan; near_person: a scored person within {} m ({} × the match distance); static_track: the hypothesis' track stays within a fixed-frame box of diagonal < {} m over its life; other: the rest. Counts are CLEAR MOT false positives under each sequence's protocol.",
+            fp_causes::NEAR_FACTOR * p.match_m,
+            fp_causes::NEAR_FACTOR,
+            fp_causes::STATIC_EXTENT_M
+        )),
+    );
     classifier::products(p, &mut out)?;
     Ok((out, data, results))
 }

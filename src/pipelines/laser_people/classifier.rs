@@ -75,12 +75,12 @@ fn finite(v: f64) -> Option<f64> {
 
 /// Why `method` has no results: its training data is absent.
 pub fn skip_reason(method: Method, p: &Params) -> Option<String> {
-    learned::absent(method.source()?, &p.learned)
+    learned::absent(method.source()?, p.learned_for(method))
 }
 
-fn rows(source: Source, m: &Result<Arc<LegModel>, Unavailable>) -> Vec<ClassifierRow> {
+fn rows(source: &str, m: &Result<Arc<LegModel>, Unavailable>) -> Vec<ClassifierRow> {
     let blank = |fold: String| ClassifierRow {
-        source: source.name().into(),
+        source: source.into(),
         fold,
         test_groups: String::new(),
         test_legs: 0,
@@ -124,12 +124,13 @@ fn bin(range_m: f64) -> Option<usize> {
 /// `(value, weight)` pairs.
 type Weighted = Vec<(f64, f64)>;
 
-/// `(value, weight)` of feature `k` of the real and the synthetic legs, at equal range.
-fn matched(real: &[Sample], syn: &[Sample], k: usize) -> (Weighted, Weighted) {
+/// `(value, weight)` of feature `k` of the real and the synthetic samples of class `leg`
+/// (legs, or clutter), at equal range.
+fn matched(real: &[Sample], syn: &[Sample], k: usize, leg: bool) -> (Weighted, Weighted) {
     let nbins = bin(RANGE_BINS_M.1 - 1e-9).unwrap_or(0) + 1;
     let count = |s: &[Sample]| {
         let mut c = vec![0usize; nbins];
-        for x in s.iter().filter(|x| x.leg) {
+        for x in s.iter().filter(|x| x.leg == leg) {
             if let Some(b) = bin(x.range_m) {
                 c[b] += 1;
             }
@@ -152,7 +153,7 @@ fn matched(real: &[Sample], syn: &[Sample], k: usize) -> (Weighted, Weighted) {
         .sum();
     let pick = |s: &[Sample], w: &dyn Fn(usize) -> f64| -> Vec<(f64, f64)> {
         s.iter()
-            .filter(|x| x.leg)
+            .filter(|x| x.leg == leg)
             .filter_map(|x| {
                 let b = bin(x.range_m)?;
                 both[b].then(|| (x.features[k], w(b)))
@@ -195,13 +196,26 @@ fn quantile(mut v: Vec<f64>, q: f64) -> f64 {
         .unwrap_or(0.0)
 }
 
-fn figures(real: &[Sample], syn: &[Sample]) -> Vec<Figure> {
-    let names = sample_feature_names();
-    FIGURE_FEATURES
+/// One figure per feature of `wanted`: real vs synthetic samples of class `leg` at equal
+/// range, named `<prefix>_<feature>`.
+fn figures(
+    real: &[Sample],
+    syn: &[Sample],
+    names: &[&str],
+    wanted: &[&str],
+    leg: bool,
+    prefix: &str,
+) -> Vec<Figure> {
+    let what = if leg {
+        "Leg clusters"
+    } else {
+        "Clutter (non-leg segments)"
+    };
+    wanted
         .iter()
         .filter_map(|f| names.iter().position(|n| n == f).map(|k| (f, k)))
         .filter_map(|(f, k)| {
-            let (r, s) = matched(real, syn, k);
+            let (r, s) = matched(real, syn, k, leg);
             if r.is_empty() || s.is_empty() {
                 return None;
             }
@@ -212,9 +226,9 @@ fn figures(real: &[Sample], syn: &[Sample]) -> Vec<Figure> {
                 .map(|i| lo + (hi - lo) * f64::from(i) / 30.0)
                 .collect();
             Some(Figure::new(
-                format!("leg_features_{f}"),
+                format!("{prefix}_{f}"),
                 format!(
-                    "Leg clusters, {f}: real vs synthetic at equal range ({}–{} m)",
+                    "{what}, {f}: real vs synthetic at equal range ({}–{} m)",
                     RANGE_BINS_M.0, RANGE_BINS_M.1
                 ),
                 FigureKind::Lines(LinePlot {
@@ -222,7 +236,7 @@ fn figures(real: &[Sample], syn: &[Sample]) -> Vec<Figure> {
                     y_label: "density".into(),
                     series: vec![
                         Series::line(
-                            format!("real (leg_tracker labels, n = {})", r.len()),
+                            format!("real (leg_tracker CSVs, n = {})", r.len()),
                             histogram(&r, &edges),
                             0,
                         ),
@@ -240,33 +254,78 @@ fn figures(real: &[Sample], syn: &[Sample]) -> Vec<Figure> {
         .collect()
 }
 
-/// The table and figures, when a learned method is listed.
+/// leg_tracker features compared in the `lt_*` figures (legs and clutter).
+pub const LT_FIGURE_FEATURES: [&str; 5] =
+    ["points", "width", "std_dev", "linearity", "circularity"];
+
+/// The table and figures, when a learned method is listed: the `[params.learned]` models
+/// (source `real` / `synthetic`, figures `leg_features_*`) and, when a free-space learned
+/// method is listed, the `[params.learned_free_space]` ones (source `real_lt` /
+/// `synthetic_lt`, figures `lt_legs_*` and `lt_clutter_*`).
 pub fn products(p: &Params, out: &mut Products) -> anyhow::Result<()> {
-    let sources: Vec<Source> = p.methods.iter().filter_map(|m| m.source()).collect();
-    if sources.is_empty() {
+    let learned_methods: Vec<&Method> = p.methods.iter().filter(|m| m.source().is_some()).collect();
+    if learned_methods.is_empty() {
         return Ok(());
     }
     let (st, gt) = (&p.synthetic.scan_topic, &p.synthetic.gt_topic);
-    let models: Vec<(Source, _)> = [Source::Real, Source::Synthetic]
-        .into_iter()
-        .map(|s| (s, learned::model(s, &p.learned, st, gt)))
-        .collect();
-    let rows: Vec<ClassifierRow> = models.iter().flat_map(|(s, m)| rows(*s, m)).collect();
+    let train = |lp: &learned::LearnedParams| -> Vec<(Source, _)> {
+        [Source::Real, Source::Synthetic]
+            .into_iter()
+            .map(|s| (s, learned::model(s, lp, st, gt)))
+            .collect()
+    };
+    let mut rows_out = Vec::new();
+    let old = learned_methods.iter().any(|m| !m.free_space());
+    let new = learned_methods.iter().any(|m| m.free_space());
+    if old {
+        let models = train(&p.learned);
+        rows_out.extend(models.iter().flat_map(|(s, m)| rows(s.name(), m)));
+        if let (Ok(r), Ok(s)) = (&models[0].1, &models[1].1) {
+            let names = sample_feature_names();
+            out.figures.extend(figures(
+                &r.samples,
+                &s.samples,
+                &names,
+                &FIGURE_FEATURES,
+                true,
+                "leg_features",
+            ));
+        }
+    }
+    if new {
+        let models = train(&p.learned_free_space);
+        rows_out.extend(
+            models
+                .iter()
+                .flat_map(|(s, m)| rows(&format!("{}_lt", s.name()), m)),
+        );
+        if let (Ok(r), Ok(s)) = (&models[0].1, &models[1].1) {
+            let names = p.learned_free_space.feature_set.names();
+            for (leg, prefix) in [(true, "lt_legs"), (false, "lt_clutter")] {
+                out.figures.extend(figures(
+                    &r.samples,
+                    &s.samples,
+                    &names,
+                    &LT_FIGURE_FEATURES,
+                    leg,
+                    prefix,
+                ));
+            }
+        }
+    }
     let mut t = Table::new(
         "leg_classifier",
         "Learned leg detectors: cross-validated precision / recall / F1 (folds grouped by file)",
-        ClassifierRow::frame(&rows)?,
+        ClassifierRow::frame(&rows_out)?,
     );
     for c in ["precision", "recall", "f1", "threshold"] {
         t = t.with_precision(c, 3);
     }
+    let (a, b) = (&p.learned, &p.learned_free_space);
     out.tables.push(t.with_note(format!(
-        "Random forest (smartcore; {} trees, depth ≤ 20, 2 features per split, seed {}) on 12 segment features (src/laser/features + range). Real: leg_tracker's training CSVs, positives = segments nearest a label within 0.1 m, negatives = every {}-th segment of the people-free scans; synthetic: every {}-th scan of the synthetic logs, legs within leg radius + 0.1 m, non-legs farther than 0.5 m from every leg within {} m (every {}-th kept). Threshold: best pooled out-of-fold F1, where each kept negative counts as the segments it stands for (precision estimated for whole scans, not the thinned sample). Test groups never appear in their fold's training.",
-        p.learned.n_trees, p.learned.seed, p.learned.negative_keep_every, p.learned.synthetic_scan_every, p.learned.max_range_m, p.learned.synthetic_negative_keep_every
+        "Random forest (smartcore; {} trees, depth ≤ 20, 2 features per split, seed {}). Sources real / synthetic: 12 segment features (src/laser/features + range) ([params.learned]); real_lt / synthetic_lt: leg_tracker's 17 cluster features ([params.learned_free_space]). Real: leg_tracker's training CSVs, positives = segments nearest a label within 0.1 m, negatives = every {}-th ({} for *_lt) segment of the people-free scans; synthetic: every {}-th scan of the synthetic logs ({} for *_lt: {}), legs within leg radius + 0.1 m, non-legs farther than 0.5 m from every leg within {} m (every {}-th kept). Threshold: best pooled out-of-fold F1, where each kept negative counts as the segments it stands for (precision estimated for whole scans, not the thinned sample). Test groups never appear in their fold's training.",
+        a.n_trees, a.seed, a.negative_keep_every, b.negative_keep_every, a.synthetic_scan_every, b.synthetic_scan_every, b.synthetic_sessions.join(", "), a.max_range_m, a.synthetic_negative_keep_every
     )));
-    if let (Ok(r), Ok(s)) = (&models[0].1, &models[1].1) {
-        out.figures.extend(figures(&r.leg_samples, &s.leg_samples));
-    }
     Ok(())
 }
 
@@ -296,7 +355,7 @@ mod tests {
             leg(3.3, 9.0),
         ];
         let syn = vec![leg(1.1, 5.0), leg(1.4, 5.0), leg(2.0, 6.0), leg(2.4, 6.0)];
-        let (r, s) = matched(&real, &syn, 0);
+        let (r, s) = matched(&real, &syn, 0, true);
         assert_eq!(r.len(), 4);
         let w: Vec<(f64, f64)> = s;
         // bin 1.0-1.5: (1/4)/(2/4) = 0.5; bin 2.0-2.5: (3/4)/(2/4) = 1.5

@@ -41,7 +41,7 @@ use serde::{Deserialize, Serialize};
 use crate::frames::laser::{self as laser_frames, LaserOptions};
 use crate::frames::truth;
 use crate::laser::points::ScanGeometry;
-use crate::laser::training::{self, Sample};
+use crate::laser::training::{self, FeatureSet, Sample, Segmented};
 use crate::learn::forest::{Forest, ForestParams};
 use crate::log::SessionLog;
 
@@ -68,6 +68,12 @@ pub struct LearnedParams {
     pub folds: usize,
     pub n_trees: u16,
     pub seed: u64,
+    /// The segment features the forest sees (`segment`: ours, 12; `leg_tracker`: its 17).
+    pub feature_set: FeatureSet,
+    /// A model file written by `peopletrack train leg-detector`: the method of this block
+    /// whose training source matches the file's `source` loads it instead of training (its
+    /// feature set and threshold come from the file). Absent: train.
+    pub model: Option<String>,
 }
 
 impl Default for LearnedParams {
@@ -85,6 +91,8 @@ impl Default for LearnedParams {
             folds: 3,
             n_trees: 100,
             seed: 1,
+            feature_set: FeatureSet::Segment,
+            model: None,
         }
     }
 }
@@ -124,6 +132,9 @@ pub struct FoldScore {
 #[derive(Debug, Serialize, Deserialize)]
 pub struct LegModel {
     pub source: Source,
+    /// Which features (files written before this field: `segment`).
+    #[serde(default)]
+    pub feature_set: FeatureSet,
     pub features: Vec<String>,
     pub threshold: f64,
     pub positives: usize,
@@ -133,12 +144,18 @@ pub struct LegModel {
     pub cv: Vec<FoldScore>,
     pub training: LearnedParams,
     pub forest: Forest,
-    /// The leg samples it was trained on (for the feature figures; not saved).
+    /// The samples it was trained on, legs and non-legs (for the feature figures; not
+    /// saved).
     #[serde(skip)]
-    pub leg_samples: Vec<Sample>,
+    pub samples: Vec<Sample>,
 }
 
 impl LegModel {
+    /// The model's feature vector of segment `i` (`None`: undefined on it).
+    pub fn features_of(&self, s: &Segmented, i: usize) -> Option<Vec<f64>> {
+        self.feature_set.of(s, i)
+    }
+
     /// Leg probability of each feature row.
     pub fn probability(&self, x: &[Vec<f64>]) -> anyhow::Result<Vec<f64>> {
         Ok(self.forest.probability(x)?)
@@ -156,7 +173,11 @@ fn read(path: &Path) -> anyhow::Result<String> {
 }
 
 /// The real training set of folder `dir` (see [`crate::laser::training`]).
-pub fn real_samples(dir: &Path, keep_every: usize) -> anyhow::Result<TrainingSet> {
+pub fn real_samples(
+    dir: &Path,
+    keep_every: usize,
+    features: FeatureSet,
+) -> anyhow::Result<TrainingSet> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .with_context(|| format!("reading {}", dir.display()))?
         .filter_map(|e| e.ok()?.file_name().into_string().ok())
@@ -174,12 +195,13 @@ pub fn real_samples(dir: &Path, keep_every: usize) -> anyhow::Result<TrainingSet
         if stem.starts_with("positive") {
             let lp = dir.join(format!("{stem}_legs.csv"));
             let labels = training::parse_legs(&read(&lp)?, &lp.display().to_string())?;
-            let (s, unmatched) = training::positive_samples(&stem, &scans, &labels);
+            let (s, unmatched) = training::positive_samples(&stem, &scans, &labels, features);
             set.samples.extend(s);
             set.unmatched_labels += unmatched;
         } else if stem.starts_with("negative") {
-            set.samples
-                .extend(training::negative_samples(&stem, &scans, keep_every));
+            set.samples.extend(training::negative_samples(
+                &stem, &scans, keep_every, features,
+            ));
         }
     }
     Ok(set)
@@ -237,6 +259,9 @@ pub fn synthetic_samples(
             let labels = training::label_synthetic(&s.centroids, &legs, p.max_range_m);
             for (i, l) in labels.iter().enumerate() {
                 let Some(leg) = *l else { continue };
+                let Some(features) = p.feature_set.of(&s, i) else {
+                    continue;
+                };
                 if !leg {
                     negatives += 1;
                     if !(negatives - 1).is_multiple_of(p.synthetic_negative_keep_every.max(1)) {
@@ -246,7 +271,7 @@ pub fn synthetic_samples(
                 samples.push(Sample {
                     group: group.clone(),
                     scan_idx: idx,
-                    features: training::sample_features(&s, i),
+                    features,
                     range_m: s.centroids[i].coords.norm(),
                     leg,
                 });
@@ -398,7 +423,10 @@ pub fn train(source: Source, set: TrainingSet, p: &LearnedParams) -> anyhow::Res
     let forest = Forest::fit(&x, &y, forest_params)?;
     Ok(LegModel {
         source,
-        features: training::sample_feature_names()
+        feature_set: p.feature_set,
+        features: p
+            .feature_set
+            .names()
             .iter()
             .map(|s| s.to_string())
             .collect(),
@@ -409,7 +437,7 @@ pub fn train(source: Source, set: TrainingSet, p: &LearnedParams) -> anyhow::Res
         cv,
         training: p.clone(),
         forest,
-        leg_samples: set.samples.iter().filter(|s| s.leg).cloned().collect(),
+        samples: set.samples.clone(),
     })
 }
 
@@ -451,7 +479,11 @@ pub fn train_source(source: Source, p: &LearnedParams, scan_topic: &str, gt_topi
         return Err(Unavailable::Absent(why));
     }
     let set = match source {
-        Source::Real => real_samples(Path::new(&p.training_dir), p.negative_keep_every),
+        Source::Real => real_samples(
+            Path::new(&p.training_dir),
+            p.negative_keep_every,
+            p.feature_set,
+        ),
         Source::Synthetic => synthetic_samples(p, scan_topic, gt_topic),
     };
     set.and_then(|s| train(source, s, p))
@@ -471,8 +503,28 @@ pub fn model(source: Source, p: &LearnedParams, scan_topic: &str, gt_topic: &str
         .unwrap_or_else(std::sync::PoisonError::into_inner);
     cache
         .entry(key)
-        .or_insert_with(|| train_source(source, p, scan_topic, gt_topic))
+        .or_insert_with(|| match loaded(source, p) {
+            Some(m) => m,
+            None => train_source(source, p, scan_topic, gt_topic),
+        })
         .clone()
+}
+
+/// The model file of `p.model` when it was trained on `source` (see [`LearnedParams::model`]);
+/// `None` when no file is named or it holds the other source's model.
+fn loaded(source: Source, p: &LearnedParams) -> Option<Cached> {
+    let path = p.model.as_deref()?;
+    let m = std::fs::read(path)
+        .with_context(|| format!("reading leg model {path}"))
+        .and_then(|b| {
+            serde_json::from_slice::<LegModel>(&b)
+                .with_context(|| format!("leg model {path} is not a model file"))
+        });
+    match m {
+        Ok(m) if m.source == source => Some(Ok(Arc::new(m))),
+        Ok(_) => None,
+        Err(e) => Some(Err(Unavailable::Failed(format!("{e:#}")))),
+    }
 }
 
 #[cfg(test)]
@@ -520,6 +572,63 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A model saved as `train leg-detector` saves it is what the pipeline uses when
+    /// `model` names the file (same source): same threshold, feature set and probabilities;
+    /// a file of the other source is ignored (that source trains, here: absent data).
+    #[test]
+    fn a_saved_model_file_is_loaded_for_its_source() {
+        let mut samples = Vec::new();
+        for k in 0..12 {
+            let x = f64::from(k);
+            for (g, leg) in [
+                ("positive_1", true),
+                ("positive_2", true),
+                ("negative_2/l", false),
+                ("negative_2/r", false),
+            ] {
+                samples.push(Sample {
+                    group: g.into(),
+                    scan_idx: k as usize,
+                    features: vec![if leg { 1.0 + x } else { -1.0 - x }; 17],
+                    range_m: 1.0,
+                    leg,
+                });
+            }
+        }
+        let p = LearnedParams {
+            feature_set: FeatureSet::LegTracker,
+            folds: 2,
+            n_trees: 5,
+            training_dir: "/nonexistent/leg_training".into(),
+            synthetic_sessions: vec!["/nonexistent/*.mcap".into()],
+            ..LearnedParams::default()
+        };
+        let set = TrainingSet {
+            samples,
+            unmatched_labels: 0,
+        };
+        let trained = train(Source::Real, set, &p).expect("trains");
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("legs.json");
+        std::fs::write(&path, serde_json::to_vec(&trained).expect("json")).expect("write");
+        let with_file = LearnedParams {
+            model: Some(path.display().to_string()),
+            ..p
+        };
+        let got = model(Source::Real, &with_file, "/scan", "/gt").expect("loaded");
+        assert_eq!(got.feature_set, FeatureSet::LegTracker);
+        assert_eq!(got.threshold, trained.threshold);
+        let x = vec![vec![3.0; 17], vec![-3.0; 17]];
+        assert_eq!(
+            got.probability(&x).expect("p"),
+            trained.probability(&x).expect("p")
+        );
+        assert!(matches!(
+            model(Source::Synthetic, &with_file, "/scan", "/gt"),
+            Err(Unavailable::Absent(_))
+        ));
     }
 
     #[test]

@@ -17,6 +17,7 @@
 mod aggregate;
 mod classifier;
 mod figures;
+mod fp_causes;
 pub mod learned;
 mod markers;
 mod methods;
@@ -39,7 +40,7 @@ pub struct LaserPeople;
 
 impl Experiment for LaserPeople {
     const KIND: &'static str = "laser_people";
-    const VERSION: u32 = 3;
+    const VERSION: u32 = 5;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {
@@ -76,14 +77,23 @@ impl Experiment for LaserPeople {
     /// when a learned method is listed.
     fn external_inputs(p: &Params) -> Vec<PathBuf> {
         let mut out = Vec::new();
-        if p.methods.contains(&methods::Method::Learned) {
-            out.push(PathBuf::from(&p.learned.training_dir));
-        }
-        if p.methods.contains(&methods::Method::LearnedSynthetic) {
-            for g in &p.learned.synthetic_sessions {
-                out.extend(glob::glob(g).into_iter().flatten().flatten());
+        for &m in &p.methods {
+            let l = p.learned_for(m);
+            match m.source() {
+                Some(learned::Source::Real) => out.push(PathBuf::from(&l.training_dir)),
+                Some(learned::Source::Synthetic) => {
+                    for g in &l.synthetic_sessions {
+                        out.extend(glob::glob(g).into_iter().flatten().flatten());
+                    }
+                }
+                None => {}
+            }
+            if let Some(f) = &l.model {
+                out.push(PathBuf::from(f));
             }
         }
+        out.sort();
+        out.dedup();
         out
     }
 

@@ -12,14 +12,15 @@
 //!   rule); synthetic `/ground_truth/people` frames (map frame) are joined to a scan by nearest
 //!   stamp and put into the laser frame through the inverse of the scan's `map` pose.
 
-use nalgebra::{Isometry3, Point2, Point3};
+use nalgebra::{Isometry3, Point2};
 
-use super::methods::{Method, Runner, ScanView};
+use super::methods::{Method, Runner, ScanView, to_laser};
 use super::params::{Params, Sequence};
 use super::tables::{self, ScanRow, SessionRow, TrackRow, TruthRow};
 use super::view;
 use crate::frames::laser::{self as laser_frames, LaserFrame, LaserOptions};
 use crate::frames::{Skips, truth};
+use crate::laser::scan_match::{MatchParams, Pose2, ScanOdometry, static_mask};
 use crate::log::SessionLog;
 use crate::log::decode::carries;
 use crate::progress::Progress;
@@ -67,16 +68,61 @@ struct Collected {
     view: view::Collector,
 }
 
-/// A fixed-frame point in the laser frame (identity without a pose).
-fn to_laser(pose: Option<&Isometry3<f64>>, p: Point2<f64>) -> Point2<f64> {
-    match pose {
-        Some(pose) => {
-            let q = pose.inverse_transform_point(&Point3::new(p.x, p.y, 0.0));
-            Point2::new(q.x, q.y)
+/// The free-space methods' pose source for a session: the log's TF where the sequence lets
+/// the methods see it and the scan has it, else scan matching (only when a free-space method
+/// runs); with, for the sessions whose TF was withheld, the true and matched poses by time
+/// for the relative pose error.
+struct Odometry {
+    matcher: Option<ScanOdometry>,
+    withhold: bool,
+    /// (time s, true pose, matched pose).
+    trace: Vec<(f64, Pose2, Pose2)>,
+}
+
+impl Odometry {
+    fn pose(&mut self, f: &LaserFrame, view: &ScanView, time_s: f64) -> Option<Isometry3<f64>> {
+        if let (false, Some(p)) = (self.withhold, f.pose) {
+            return Some(p);
         }
-        None => p,
+        let m = self.matcher.as_mut()?;
+        let keep = static_mask(&view.points, &view.segments, &view.geometric, &m.params);
+        let est = m.step(&view.points, &keep);
+        if let Some(truth) = f.pose {
+            self.trace
+                .push((time_s, Pose2::of(&truth), Pose2::of(&est)));
+        }
+        Some(est)
+    }
+
+    /// The mean relative pose error over 1 s windows (m, degrees); NaN without a trace.
+    fn rpe(&self) -> (f64, f64) {
+        let mut sum = (0.0, 0.0, 0usize);
+        let mut j = 0;
+        for (i, (t, truth, est)) in self.trace.iter().enumerate() {
+            while j < i && self.trace[j + 1].0 <= t - RPE_WINDOW_S {
+                j += 1;
+            }
+            let (t0, truth0, est0) = &self.trace[j];
+            if t - t0 < RPE_WINDOW_S {
+                continue;
+            }
+            let a = truth0.inverse().compose(truth);
+            let b = est0.inverse().compose(est);
+            let e = a.inverse().compose(&b);
+            sum.0 += e.x.hypot(e.y);
+            sum.1 += e.theta.abs().to_degrees();
+            sum.2 += 1;
+        }
+        if sum.2 == 0 {
+            (f64::NAN, f64::NAN)
+        } else {
+            (sum.0 / sum.2 as f64, sum.1 / sum.2 as f64)
+        }
     }
 }
+
+/// Window of the relative pose error (s).
+const RPE_WINDOW_S: f64 = 1.0;
 
 fn track_row(
     detector: &str,
@@ -99,23 +145,27 @@ fn track_row(
 /// One scan through every method (and the synthetic ground truth, when given).
 fn scan_step(
     f: &LaserFrame,
-    idx: i64,
-    time_s: f64,
+    (idx, time_s): (i64, f64),
     runners: &mut [(Method, Runner)],
+    odometry: &mut Odometry,
     gt: Option<&crate::groundtruth::PeopleFrame>,
     out: &mut Collected,
 ) {
-    let view = ScanView::new(f);
+    let mut view = ScanView::new(f, f.pose.filter(|_| !odometry.withhold));
+    let odom = odometry.pose(f, &view, time_s);
+    view.set_odometry(odom);
     let d = &view.geometric;
-    let pose = f.pose.as_ref();
     out.view.observe(idx, f, &view.points);
     for (method, runner) in runners.iter_mut() {
         for h in runner.step(&view, time_s) {
-            let laser = h.laser.unwrap_or_else(|| to_laser(pose, h.world));
+            let laser = h
+                .laser
+                .unwrap_or_else(|| to_laser(view.pose.as_ref(), h.world));
             out.tracks
                 .push(track_row(method.name(), idx, h.id, laser, h.world));
         }
     }
+    let pose = f.pose.as_ref();
     if let Some(frame) = gt {
         for person in &frame.people {
             match pose {
@@ -206,13 +256,22 @@ pub(super) fn process(
     for &m in &p.methods {
         if let Some(r) = Runner::new(
             m,
-            &p.learned,
-            &p.synthetic.scan_topic,
-            &p.synthetic.gt_topic,
+            p.learned_for(m),
+            (&p.synthetic.scan_topic, &p.synthetic.gt_topic),
+            seq.publish_occluded,
         )? {
             runners.push((m, r));
         }
     }
+    let mut odometry = Odometry {
+        matcher: p
+            .methods
+            .iter()
+            .any(|m| m.free_space())
+            .then(|| ScanOdometry::new(MatchParams::default())),
+        withhold: seq.withhold_odometry,
+        trace: Vec::new(),
+    };
     let mut out = Collected {
         view: view::Collector::new(seq.scans),
         ..Collected::default()
@@ -225,7 +284,14 @@ pub(super) fn process(
         let gt = (kind == GtKind::Synthetic)
             .then(|| synthetic.nearest(f.stamp, tolerance_ns))
             .flatten();
-        scan_step(&f, idx as i64, time_s, &mut runners, gt, &mut out);
+        scan_step(
+            &f,
+            (idx as i64, time_s),
+            &mut runners,
+            &mut odometry,
+            gt,
+            &mut out,
+        );
         bar.inc(1);
     }
     let fixed_frame = frames.fixed_frame().unwrap_or_default().to_string();
@@ -236,7 +302,21 @@ pub(super) fn process(
         skips.merge(gt_skips);
         place_leg_tracker(&rows, &mut out);
     }
+    let (rpe_m, rpe_deg) = odometry.rpe();
+    let matched = odometry
+        .matcher
+        .as_ref()
+        .filter(|_| odometry.withhold || out.scans.iter().any(|s| !s.posed));
     let session = SessionRow {
+        odometry: if matched.is_some() {
+            "scan_match"
+        } else {
+            "tf"
+        }
+        .into(),
+        scan_match_failures: matched.map_or(0, |m| m.failures() as i64),
+        odometry_rpe_m: rpe_m,
+        odometry_rpe_deg: rpe_deg,
         scan_topic: seq.scan_topic.clone(),
         gt_topic: seq.gt_topic.clone(),
         gt_kind: kind.name().into(),

@@ -26,6 +26,15 @@ table_row! {
         pub scans: i64,
         /// Scans TF could not place (tracked in the sensor frame).
         pub unposed: i64,
+        /// The free-space methods' fixed frame: `tf` (the log's) or `scan_match`
+        /// ([`crate::laser::scan_match`]: no TF, or the sequence withholds it).
+        pub odometry: String,
+        /// Scans the scan matcher could not match (they took its prediction).
+        pub scan_match_failures: i64,
+        /// Where the log's TF was withheld: the scan-matched odometry's mean relative pose
+        /// error over 1 s windows against TF (m, degrees); NaN otherwise.
+        pub odometry_rpe_m: f64,
+        pub odometry_rpe_deg: f64,
         /// Ground-truth positions kept.
         pub gt_rows: i64,
         /// Ground-truth positions dropped: before the first scan, a second position of the

@@ -303,7 +303,10 @@ fn actors(
                 id: next_id,
                 height,
                 width: 0.17 + 0.06 * r.random::<f64>(),
-                leg_radius: 0.055 + 0.02 * r.random::<f64>(),
+                leg_radius: {
+                    let [lo, hi] = c.leg_radius.unwrap_or([0.055, 0.075]);
+                    lo + (hi - lo) * r.random::<f64>()
+                },
                 upper: random_color(&mut r),
                 lower: random_color(&mut r),
                 skin: skin_tone(&mut r),
