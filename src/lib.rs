@@ -5,6 +5,8 @@
 //! `ARCHITECTURE.md` for the map.
 
 pub mod assign;
+pub mod anchoring;
+pub mod audio;
 pub mod calib;
 pub mod eval;
 pub mod frames;

@@ -11,6 +11,7 @@ pub mod run;
 pub mod score;
 pub mod synth;
 pub mod train;
+pub mod wav;
 
 use std::io::{self, Write};
 use std::process::ExitCode;
@@ -62,6 +63,9 @@ pub enum Command {
     /// Write a public dataset as a session log, e.g.
     /// `peopletrack import wildtrack ../shared/real/wildtrack -o wildtrack.mcap`.
     Import(import::Args),
+    /// Write a session's two-microphone audio as a WAV file to listen to, e.g.
+    /// `peopletrack wav datasets/biron_home/biron_home_00.mcap -o biron.wav`.
+    Wav(wav::Args),
 }
 
 /// Parse arguments, run the command, and map the outcome to an exit code:
@@ -90,6 +94,7 @@ pub fn main() -> ExitCode {
         Command::Score(a) => score::run(a, &mut out),
         Command::Train(a) => train::run(a, &mut out),
         Command::Import(a) => import::run(a, &mut out),
+        Command::Wav(a) => wav::run(a, &mut out),
     }
     .and_then(|()| out.flush().map_err(anyhow::Error::from));
     match result {

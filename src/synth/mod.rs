@@ -9,11 +9,15 @@
 //! - [`render`]: per-pixel ray casting for every camera model; [`laser`]: scans.
 //! - [`session`]: one session written as a log, returning what its preview sheet shows
 //!   ([`PreviewData`]; `report::preview` draws the sheet — the synthesizer draws nothing).
+//! - [`biron`]: seed 003's BIRON home tour (`[biron]` scenarios): visitors, two-microphone
+//!   audio, faces ([`face`]), and the pan-tilt camera in closed loop with the attention system.
 //! - [`rng`]: seeded randomness.
 //!
 //! Not modelled: global illumination, cast shadows other than soft floor shadows under people,
 //! motion blur, rolling shutter, lens vignetting.
 
+pub mod biron;
+pub mod face;
 pub mod follow;
 pub mod laser;
 pub mod motion;

@@ -122,6 +122,32 @@ impl Body {
 
     /// Append the body's primitives.
     pub fn primitives(&self, s: &PersonState, out: &mut Vec<Primitive>) {
+        self.primitives_with_head(s, None, out);
+    }
+
+    /// Append the body's primitives with a painted face ([`super::face`]) on a head turned to
+    /// `head_yaw` (rad, in the world; the body keeps `s.heading`).
+    pub fn primitives_with_face(&self, s: &PersonState, head_yaw: f64, out: &mut Vec<Primitive>) {
+        self.primitives_with_head(s, Some((head_yaw, &super::face::DEFAULT_STYLE)), out);
+    }
+
+    /// As [`Self::primitives_with_face`] with the face drawn in `style`.
+    pub fn primitives_with_face_style(
+        &self,
+        s: &PersonState,
+        head_yaw: f64,
+        style: &'static super::face::FaceStyle,
+        out: &mut Vec<Primitive>,
+    ) {
+        self.primitives_with_head(s, Some((head_yaw, style)), out);
+    }
+
+    fn primitives_with_head(
+        &self,
+        s: &PersonState,
+        face: Option<(f64, &'static super::face::FaceStyle)>,
+        out: &mut Vec<Primitive>,
+    ) {
         let id = self.object();
         let h = self.height;
         let (sn, cs) = s.heading.sin_cos();
@@ -223,20 +249,29 @@ impl Body {
             .skin_below(f64::INFINITY),
         );
         let head = self.head_center(s);
-        let hairline = head.z + 0.035;
+        let hairline = head.z + super::face::HAIRLINE_U;
+        let texture = match face {
+            None => Texture::Split {
+                z: hairline as f32,
+                above: linear(self.hair),
+            },
+            Some((yaw, style)) => Texture::Face {
+                center: [head.x as f32, head.y as f32, head.z as f32],
+                yaw: yaw as f32,
+                hair: linear(self.hair),
+                style,
+            },
+        };
         out.push(
             Primitive::new(
                 Shape::Ellipsoid {
                     center: head,
                     radii: Vector3::new(0.1, 0.085, HEAD_HALF_HEIGHT),
-                    yaw: s.heading,
+                    yaw: face.map_or(s.heading, |f| f.0),
                 },
                 Material {
                     albedo: linear(self.skin),
-                    texture: Texture::Split {
-                        z: hairline as f32,
-                        above: linear(self.hair),
-                    },
+                    texture,
                     emissive: false,
                 },
                 id,

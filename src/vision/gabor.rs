@@ -512,8 +512,7 @@ impl GaborBackground {
         }
         let mut median = RgbImage::new(w, h);
         let k = frames.len();
-        median
-            .as_mut()
+        AsMut::<[u8]>::as_mut(&mut median)
             .par_chunks_mut(3 * w as usize)
             .enumerate()
             .for_each(|(y, row)| {

@@ -40,6 +40,7 @@ pub mod blobs;
 pub mod colortrack;
 pub mod cylinder;
 pub mod egomotion;
+pub mod faces;
 pub mod ellipse;
 pub mod gabor;
 pub mod gmm;
