@@ -53,11 +53,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all(out)?;
     let mut style = DEFAULT_STYLE;
     let mut thresh = 2.0;
+    let mut width = 320u32;
+    let mut min_face = 20u32;
     for a in &args[1..] {
         let (k, v) = a.split_once('=').ok_or("arguments are key=value")?;
         let v: f64 = v.parse()?;
         if k == "thresh" {
             thresh = v;
+        } else if k == "width" {
+            width = v as u32;
+        } else if k == "minface" {
+            min_face = v as u32;
         } else {
             set(&mut style, k, v)?;
         }
@@ -65,11 +71,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let style: &'static FaceStyle = Box::leak(Box::new(style));
     let (s, _) = Scenario::load(std::path::Path::new("datasets/biron_home/scenario.toml"), "quick")?;
     let world = World::build(&s, 0);
-    let cam = Camera::new("c", CameraModel::Pinhole(Pinhole::from_fov(320, 240, 48.8)), 2.0, None, 0);
-    let pose = geometry::pose_xyz_rpy([2.5, 3.0, 1.41], [0.0, 0.1, 0.0])
+    let height = width * 3 / 4;
+    let cam = Camera::new("c", CameraModel::Pinhole(Pinhole::from_fov(width, height, 48.8)), 2.0, None, 0);
+    let pose = geometry::pose_xyz_rpy([2.5, 3.0, 1.41], [0.0, 0.0, 0.0])
         * Isometry3::from_parts(Translation3::identity(), geometry::body_from_optical());
     let mut det = FaceDetector::new(FaceParams {
         score_thresh: thresh,
+        min_face_px: min_face,
         ..FaceParams::default()
     })?;
     let skins = [[224, 172, 140], [198, 140, 105], [150, 100, 70]];
@@ -87,6 +95,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             hands: false,
         };
         for d in [1.3, 1.8, 2.4, 3.0] {
+            let clock = std::time::Instant::now();
             let mut line = format!("skin {si} d {d}:");
             for yaw_deg in [0.0f64, 10.0, 20.0, 30.0, 45.0, 60.0, 90.0, 180.0] {
                 let st = PersonState {
@@ -108,8 +117,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     pose,
                     noise_key: 7,
                 });
-                let grey = grey_from_rgb(ImageView::new(&f.rgb, 320, 240, 3)?)?;
-                let faces = det.detect(ImageView::new(&grey, 320, 240, 1)?)?;
+                let (w, h) = (width as usize, height as usize);
+                let grey = grey_from_rgb(ImageView::new(&f.rgb, w, h, 3)?)?;
+                let faces = det.detect(ImageView::new(&grey, w, h, 1)?)?;
                 line += &format!(
                     " {yaw_deg}:{}",
                     faces
@@ -119,12 +129,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         .join("")
                 );
                 if yaw_deg == 0.0 {
-                    image::RgbImage::from_raw(320, 240, f.rgb.clone())
+                    image::RgbImage::from_raw(width, height, f.rgb.clone())
                         .ok_or("frame")?
                         .save(format!("{out}/face_{si}_{d}.png"))?;
                 }
             }
-            println!("{line}");
+            println!("{line} ({:.2} s per frame)", clock.elapsed().as_secs_f64() / 8.0);
         }
     }
     Ok(())

@@ -3,8 +3,9 @@
 //! bearings are world azimuths seen from the camera or from the microphones' centre.
 //!
 //! - **Legs**: each confirmed track of the laser people tracker grounds the anchor that holds
-//!   its id; a new track is adopted by a leg-less anchor within [`FusionParams::adopt_m`], else
-//!   starts a new anchor. The anchor's position is its track's.
+//!   its id; a new track is adopted by the nearest anchor within [`FusionParams::adopt_m`] that
+//!   has no track or whose track the tracker dropped, else starts a new anchor. The anchor's
+//!   position is its track's.
 //! - **Faces**: a face's bearing is associated with the anchor nearest in bearing within
 //!   [`FusionParams::face_gate_rad`] whose distance agrees with the face's width within
 //!   [`FusionParams::face_range_ratio`]; it grounds the face component and gives the person's
@@ -13,7 +14,8 @@
 //! - **Torso**: the colour below a person's first associated face becomes the torso model;
 //!   each frame the colour tracker starts where the anchor's torso projects and grounds the
 //!   torso component when it settles within [`FusionParams::torso_gate_rad`] with a
-//!   Bhattacharyya coefficient of at least [`FusionParams::torso_min_rho`].
+//!   Bhattacharyya coefficient of at least [`FusionParams::torso_min_rho`], within
+//!   [`FusionParams::torso_hold_s`] of the legs' or face's last percept.
 //! - **Voice**: the sound's cone angle is turned into each anchor's front azimuth with its own
 //!   elevation (mouth height from the person's height, range from the microphones) and lands
 //!   on the nearest within [`FusionParams::voice_gate_rad`].
@@ -48,11 +50,15 @@ pub struct FusionParams {
     pub voice_gate_rad: f64,
     /// A face's width-derived distance must be within this factor of the anchor's.
     pub face_range_ratio: f64,
-    /// A new leg track is adopted by a leg-less anchor this close (m).
+    /// A new leg track is adopted by an anchor without a live track this close (m): about a
+    /// face-derived distance's error at 2 m.
     pub adopt_m: f64,
     /// Height of a person before a face gives it (m).
     pub default_height_m: f64,
     pub torso_min_rho: f64,
+    /// The torso grounds a person only this long (s) after its legs or face last did (the
+    /// colour alone would hold a phantom on a background of its own colour).
+    pub torso_hold_s: f64,
 }
 
 impl Default for FusionParams {
@@ -67,9 +73,10 @@ impl Default for FusionParams {
             torso_gate_rad: 8.0 * deg,
             voice_gate_rad: 8.0 * deg,
             face_range_ratio: 1.6,
-            adopt_m: 0.6,
+            adopt_m: 0.8,
             default_height_m: 1.70,
             torso_min_rho: 0.6,
+            torso_hold_s: 3.0,
         }
     }
 }
@@ -171,11 +178,15 @@ impl Fusion {
             let k = match self.anchors.iter().position(|a| a.leg_track == Some(tr.id)) {
                 Some(k) => k,
                 None => {
+                    // anchors without a track, or whose track the tracker dropped
                     let near = self
                         .anchors
                         .iter()
                         .enumerate()
-                        .filter(|(_, a)| a.leg_track.is_none() || !a.legs.alive(t))
+                        .filter(|(_, a)| {
+                            a.leg_track
+                                .is_none_or(|id| tracks.iter().all(|x| x.id != id))
+                        })
                         .map(|(k, a)| {
                             let d = (a.position[0] - tr.position[0])
                                 .hypot(a.position[1] - tr.position[1]);
@@ -257,6 +268,7 @@ impl Fusion {
         let o = view.origin();
         let gate = self.params.torso_gate_rad;
         let min_rho = self.params.torso_min_rho;
+        let hold = self.params.torso_hold_s;
         for a in &mut self.anchors {
             let Some(model) = a.torso_model.as_mut() else {
                 continue;
@@ -266,7 +278,11 @@ impl Fusion {
             };
             let (az, _) = view.bearing_elevation(center);
             let db = wrap(bearing_from([o.x, o.y], a.position) - az).abs();
-            if rho >= min_rho && db <= gate {
+            let held = [a.legs.last_s, a.face.last_s]
+                .iter()
+                .flatten()
+                .any(|l| t - l <= hold);
+            if rho >= min_rho && db <= gate && held {
                 a.torso.ground(t);
                 if !a.legs.alive(t) && !a.face.alive(t) {
                     let r = (a.position[0] - o.x).hypot(a.position[1] - o.y);
@@ -312,5 +328,90 @@ impl Fusion {
         let speaking = a.voice.alive(t);
         let looking = a.in_view.then(|| a.face.alive(t));
         (speaking, looking)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::anchoring::attention::category;
+
+    fn at(r: f64, deg: f64) -> [f64; 2] {
+        let a = deg.to_radians();
+        [r * a.cos(), r * a.sin()]
+    }
+
+    fn two_people() -> Fusion {
+        let mut f = Fusion::new(FusionParams::default(), Modalities::ALL);
+        f.legs(
+            0.0,
+            &[
+                LegTrack {
+                    id: 7,
+                    position: at(2.0, 20.0),
+                },
+                LegTrack {
+                    id: 9,
+                    position: at(1.5, -30.0),
+                },
+            ],
+        );
+        f
+    }
+
+    #[test]
+    fn leg_tracks_start_anchors_and_keep_their_ids() {
+        let mut f = two_people();
+        assert_eq!(f.anchors.len(), 2);
+        f.legs(
+            0.1,
+            &[LegTrack {
+                id: 7,
+                position: at(2.1, 20.0),
+            }],
+        );
+        assert_eq!(f.anchors.len(), 2, "a known track moves its anchor");
+        assert!((f.anchors[0].position[0] - at(2.1, 20.0)[0]).abs() < 1e-12);
+        assert_eq!(f.anchors[0].legs.state(0.1), State::Grounded);
+        assert_eq!(f.anchors[1].legs.state(0.1), State::Grounded);
+        assert_eq!(f.anchors[1].legs.state(0.5), State::Associated);
+        f.prune(2.0);
+        assert!(f.anchors.is_empty(), "every component lost after the legs' 1 s timeout");
+    }
+
+    #[test]
+    fn a_sound_lands_on_the_person_in_its_direction_once_the_mouth_height_is_corrected() {
+        let mut f = two_people();
+        let mics = [0.0, 0.0, doa::BIRON_MIC_HEIGHT_M];
+        // the true cone of the first person's mouth (1.53 m high at 2 m, 20° left)
+        let (id, mouth_z) = (f.anchors[0].id, f.anchors[0].mouth_z());
+        let el = doa::elevation(mouth_z, mics[2], 2.0);
+        let cone = (20f64.to_radians().sin() * el.cos()).asin();
+        assert!(cone.to_degrees() < 19.5, "the raw cone angle is smaller than the azimuth");
+        assert_eq!(f.sound(0.0, cone, mics, 0.0), Some(id));
+        let (speaking, looking) = f.cues(&f.anchors[0], 0.0);
+        assert!(speaking);
+        assert_eq!(looking, None, "never in a camera's view: cannot be judged");
+        assert_eq!(category(speaking, looking), 2);
+        // a direction between the two people lands on nobody
+        assert_eq!(f.sound(0.0, (-5f64).to_radians(), mics, 0.0), None);
+    }
+
+    #[test]
+    fn a_source_behind_the_robot_lands_on_a_person_at_its_mirror_in_front() {
+        let mut f = two_people();
+        let mics = [0.0, 0.0, doa::BIRON_MIC_HEIGHT_M];
+        // a talker behind at 160° has the cone of 20° in front: the first person gets it
+        let (id, mouth_z) = (f.anchors[0].id, f.anchors[0].mouth_z());
+        let el = doa::elevation(mouth_z, mics[2], 2.0);
+        let cone = (160f64.to_radians().sin() * el.cos()).asin();
+        assert_eq!(f.sound(0.0, cone, mics, 0.0), Some(id));
+    }
+
+    #[test]
+    fn without_the_sound_modality_no_sound_lands() {
+        let mut f = two_people();
+        f.modalities.sound = false;
+        assert_eq!(f.sound(0.0, 0.3, [0.0, 0.0, 1.06], 0.0), None);
     }
 }

@@ -297,3 +297,60 @@ impl System {
         out
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spoken(command: Option<Command>, mouth: [f64; 2]) -> Spoken {
+        Spoken {
+            index: 0,
+            start: 1.0,
+            end: 2.0,
+            command,
+            mouth,
+        }
+    }
+
+    /// A system listening to one anchor at (2, 0).
+    fn listening() -> System {
+        let mut s = System::new(SystemParams::default(), Modalities::ALL);
+        s.fusion.legs(
+            0.0,
+            &[LegTrack {
+                id: 1,
+                position: [2.0, 0.0],
+            }],
+        );
+        s.attention.mode = Mode::Listen;
+        s.attention.focus = Some(s.fusion.anchors[0].id);
+        s
+    }
+
+    #[test]
+    fn a_greeting_is_heard_when_the_beam_is_on_the_speaker_for_half_the_utterance() {
+        let mut s = listening();
+        let u = [spoken(Some(Command::Greeting), [2.1, 0.1])];
+        for k in 10..20 {
+            assert!(s.dialog(f64::from(k) / 10.0, &u).is_empty(), "nothing before the end");
+        }
+        let id = s.fusion.anchors[0].id;
+        assert_eq!(s.dialog(2.0, &u), vec![(Command::Greeting, id)]);
+        assert!(s.dialog(2.1, &u).is_empty(), "heard once");
+    }
+
+    #[test]
+    fn nothing_is_heard_from_a_speaker_off_the_beam_or_while_not_listening() {
+        let mut s = listening();
+        let off = [spoken(Some(Command::Greeting), [2.0, 1.0])];
+        for k in 10..=20 {
+            assert!(s.dialog(f64::from(k) / 10.0, &off).is_empty());
+        }
+        let mut s = listening();
+        s.attention.mode = Mode::Alert;
+        let on = [spoken(Some(Command::Goodbye), [2.0, 0.0])];
+        for k in 10..=20 {
+            assert!(s.dialog(f64::from(k) / 10.0, &on).is_empty());
+        }
+    }
+}

@@ -278,6 +278,9 @@ impl Body {
             )
             .skin_below(hairline),
         );
+        if let Some((yaw, _)) = face {
+            self.face_relief(head, yaw, id, out);
+        }
         if let Some(hat) = self.hat {
             out.push(Primitive::new(
                 Shape::Cylinder {
@@ -290,6 +293,28 @@ impl Body {
                 Material::flat(hat),
                 id,
             ));
+        }
+    }
+
+    /// A face's relief: the nose (in front of the head centre, 2.5 cm below it) and the ears
+    /// (at the sides), small skin ellipsoids that turn with the head's yaw.
+    fn face_relief(&self, head: Point3<f64>, yaw: f64, id: u32, out: &mut Vec<Primitive>) {
+        let (sn, cs) = yaw.sin_cos();
+        let at = |f: f64, s: f64, u: f64| head + Vector3::new(f * cs - s * sn, f * sn + s * cs, u);
+        let parts = [
+            (at(0.092, 0.0, -0.025), Vector3::new(0.022, 0.011, 0.028)),
+            (at(0.0, 0.084, -0.005), Vector3::new(0.012, 0.008, 0.03)),
+            (at(0.0, -0.084, -0.005), Vector3::new(0.012, 0.008, 0.03)),
+        ];
+        for (center, radii) in parts {
+            out.push(
+                Primitive::new(
+                    Shape::Ellipsoid { center, radii, yaw },
+                    Material::flat(self.skin),
+                    id,
+                )
+                .skin_below(f64::INFINITY),
+            );
         }
     }
 

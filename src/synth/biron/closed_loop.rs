@@ -188,190 +188,21 @@ impl Run<'_> {
     pub fn write(&self, w: &mut SessionWriter, bar: &dyn Progress) -> Result<PreviewData, SynthError> {
         let ch = self.channels(w)?;
         let dur = self.stage.duration;
-        let rate = self.spec.rate_hz;
-        let steps = (dur * rate).floor() as usize;
+        let steps = (dur * self.spec.rate_hz).floor() as usize;
         bar.set_length(steps as u64);
-        let model = Pinhole::from_fov(self.spec.camera[0], self.spec.camera[1], self.spec.hfov_deg);
-        let cam = Camera::new("camera", CameraModel::Pinhole(model.clone()), 2.0, None, 0);
-        let spec = laser_spec();
-        let laser_pose = self.base() * pose(LASER_XZ[0], 0.0, LASER_XZ[1], 0.0);
-        let geometry = ScanGeometry {
-            angle_min: spec.angle_min(),
-            angle_increment: spec.increment,
-            range_min: spec.range_min,
-            range_max: spec.range_max,
-        };
-        let params = SystemParams::default();
-        let mut system = System::new(params, Modalities::ALL);
-        let mut legs = LegFront::new(TrackerParams::default());
-        let mut sound = SoundFront::new(&params).map_err(|e| SynthError::Scenario(e.to_string()))?;
-        let mut faces = FaceDetector::new(FaceParams::default())
-            .map_err(|e| SynthError::Scenario(e.to_string()))?;
-        let nominal = self
-            .conditions
-            .iter()
-            .position(|c| [c.rt60_s, c.snr_db] == self.spec.nominal)
-            .unwrap_or(0);
-        let (m0, m1) = deinterleave(&self.conditions[nominal].samples);
-        let fs = f64::from(self.setup.sample_rate);
-        let block = (params.sound_block_s * fs) as usize;
-        let mut truth_att = truth::TrueAttention::default();
-        let mut ptu = PanTilt::default();
-        let mut next_chunk = 0usize;
-        let mut next_scan = 0usize;
-        let mut latest: Option<Vec<LegTrack>> = None;
+        let mut lp = Loop::new(self)?;
         let mut preview = None;
-        let mics = {
-            let a = self.setup.mic(self.stage.robot, 0);
-            let b = self.setup.mic(self.stage.robot, 1);
-            [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, a[2]]
-        };
         for k in 0..steps {
-            let t = k as f64 / rate;
-            let stamp = self.at(t);
-            // audio chunks that ended by now
-            while (next_chunk + 1) * CHUNK_FRAMES <= (t * fs) as usize {
-                self.write_chunk(w, &ch, next_chunk)?;
-                next_chunk += 1;
-            }
-            // scans up to now
-            loop {
-                let ts = LASER_PHASE_S + next_scan as f64 / LASER_RATE_HZ;
-                if ts > t {
-                    break;
-                }
-                let prims = self.scene(ts);
-                let key = rng::hash(self.seed, &[next_scan as u64, 0x1a5e]);
-                let (ranges, _) = scan(&spec, &laser_pose, &[&self.world.statics, &prims], key);
-                let s_stamp = self.at(ts);
-                w.write(
-                    ch.scan,
-                    Nanos(s_stamp.0 + 5_000_000),
-                    &LaserScan {
-                        header: Header::new(s_stamp, "laser"),
-                        angle_min: spec.angle_min() as f32,
-                        angle_max: (spec.angle_min() + (spec.beams() - 1) as f64 * spec.increment)
-                            as f32,
-                        angle_increment: spec.increment as f32,
-                        time_increment: 0.0,
-                        scan_time: (1.0 / LASER_RATE_HZ) as f32,
-                        range_min: spec.range_min as f32,
-                        range_max: spec.range_max as f32,
-                        ranges: ranges.clone(),
-                        intensities: Vec::new(),
-                    },
-                )?;
-                let ts_logged = (s_stamp.0 - self.t0.0) as f64 * 1e-9;
-                latest = Some(legs.scan(ts_logged, &ranges, &geometry, Some(&laser_pose)));
-                next_scan += 1;
-            }
-            // the camera frame with the unit where the system turned it
-            let prims = self.scene(t);
-            let cam_pose = camera_pose(&self.base(), ptu);
-            let frame = cam.render(&FrameInput {
-                world: self.world,
-                dynamic: &prims,
-                shadows: &[],
-                t,
-                pose: cam_pose,
-                noise_key: rng::hash(self.seed, &[k as u64, 0xca]),
-            });
-            let (wd, ht) = (frame.width, frame.height);
-            let mut jpeg = Vec::new();
-            image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, JPEG_QUALITY)
-                .encode(&frame.rgb, wd, ht, image::ExtendedColorType::Rgb8)
-                .map_err(|e| SynthError::Encode {
-                    camera: "camera".into(),
-                    reason: e.to_string(),
-                })?;
-            let log = Nanos(stamp.0 + 15_000_000);
-            let header = Header::new(stamp, "camera_optical");
-            let base_from_optical = self.base().inverse() * cam_pose;
-            w.write(
-                ch.tf,
-                Nanos(stamp.0 + 1_000_000),
-                &TfMessage {
-                    transforms: vec![tf("base_link", "camera_optical", stamp, &base_from_optical)],
-                },
-            )?;
-            w.write(
-                ch.joints,
-                Nanos(stamp.0 + 1_000_000),
-                &JointState {
-                    header: Header::new(stamp, "base_link"),
-                    name: vec!["pan".into(), "tilt".into()],
-                    position: vec![ptu.pan, ptu.tilt],
-                    velocity: Vec::new(),
-                    effort: Vec::new(),
-                },
-            )?;
-            w.write(
-                ch.image,
-                log,
-                &CompressedImage {
-                    header: header.clone(),
-                    format: "jpeg".into(),
-                    data: jpeg.clone(),
-                },
-            )?;
-            w.write(ch.info, log, &CameraInfo::from_model(&CameraModel::Pinhole(model.clone()), header))?;
-            // the system's step on what was logged
-            let rgb = image::load_from_memory_with_format(&jpeg, image::ImageFormat::Jpeg)
-                .map_err(|e| SynthError::Encode {
-                    camera: "camera".into(),
-                    reason: e.to_string(),
-                })?
-                .to_rgb8();
-            let view = CameraView {
-                model: model.clone(),
-                pose: cam_pose,
-            };
-            let rgb_view = ImageView::rgb(&rgb).map_err(|e| SynthError::Scenario(e.to_string()))?;
-            let grey = grey_from_rgb(rgb_view).map_err(|e| SynthError::Scenario(e.to_string()))?;
-            let grey_view = ImageView::new(&grey, wd as usize, ht as usize, 1)
-                .map_err(|e| SynthError::Scenario(e.to_string()))?;
-            let found = faces
-                .detect(grey_view)
-                .map_err(|e| SynthError::Scenario(e.to_string()))?;
-            let bins = BinImage::new(rgb_view, ColorSpace::Hs)
-                .map_err(|e| SynthError::Scenario(e.to_string()))?;
-            let end = (t * fs).round() as usize;
-            let percept = if end >= block {
-                Some(
-                    sound
-                        .block(t, &m0[end - block..end], &m1[end - block..end])
-                        .map_err(|e| SynthError::Scenario(e.to_string()))?,
-                )
-            } else {
-                None
-            };
-            let spoken = spoken(self.script, t, 1.0 / rate);
-            let out = system.step(&StepInput {
-                t,
-                robot: self.stage.robot,
-                mics,
-                legs: latest.take().as_deref(),
-                view: &view,
-                faces: &found,
-                bins: &bins,
-                sound: percept,
-                spoken: &spoken,
-            });
-            w.write_json(ch.state, Nanos(stamp.0 + 30_000_000), &state_of(&system, &out, stamp, t))?;
-            // ground truth of the instant
-            let (people, biron) = truth_att.step(self, t, stamp, &view, &frame.ids);
-            w.write_json(ch.people, stamp, &PeopleFrame { stamp_ns: stamp.0, people })?;
-            w.write_json(ch.biron, stamp, &biron)?;
+            let t = k as f64 / self.spec.rate_hz;
+            lp.chunks_until(self, w, &ch, t)?;
+            lp.scans_until(self, w, &ch, t)?;
+            let (frame, biron) = lp.frame(self, w, &ch, k, t)?;
             if k == steps / 2 {
-                preview = Some(self.preview(t, &frame.rgb, wd, ht, &biron));
+                preview = Some(self.preview(t, &frame.rgb, frame.width, frame.height, &biron));
             }
-            ptu = out.ptu;
             bar.inc(1);
         }
-        while (next_chunk + 1) * CHUNK_FRAMES <= (dur * fs) as usize {
-            self.write_chunk(w, &ch, next_chunk)?;
-            next_chunk += 1;
-        }
+        lp.chunks_until(self, w, &ch, dur)?;
         preview.ok_or_else(|| SynthError::Scenario("a BIRON session needs at least one frame".into()))
     }
 
@@ -422,6 +253,231 @@ impl Run<'_> {
             sensors: vec![("camera".to_string(), self.stage.camera)],
             world: self.world.clone(),
         }
+    }
+}
+
+fn scen(e: impl std::fmt::Display) -> SynthError {
+    SynthError::Scenario(e.to_string())
+}
+
+/// The closed loop's state between steps: the robot's attention system and its percept
+/// fronts, the pan-tilt unit, what has been written so far, the true attention.
+struct Loop {
+    model: Pinhole,
+    cam: Camera,
+    laser: LaserSpec,
+    laser_pose: Isometry3<f64>,
+    geometry: ScanGeometry,
+    params: SystemParams,
+    system: System,
+    legs: LegFront,
+    sound: SoundFront,
+    faces: FaceDetector,
+    mic: (Vec<f32>, Vec<f32>),
+    mics: [f64; 3],
+    truth: truth::TrueAttention,
+    ptu: PanTilt,
+    next_chunk: usize,
+    next_scan: usize,
+    latest: Option<Vec<LegTrack>>,
+}
+
+impl Loop {
+    fn new(run: &Run) -> Result<Loop, SynthError> {
+        let model = Pinhole::from_fov(run.spec.camera[0], run.spec.camera[1], run.spec.hfov_deg);
+        let laser = laser_spec();
+        let geometry = ScanGeometry {
+            angle_min: laser.angle_min(),
+            angle_increment: laser.increment,
+            range_min: laser.range_min,
+            range_max: laser.range_max,
+        };
+        let params = SystemParams::default();
+        let nominal = run
+            .conditions
+            .iter()
+            .position(|c| [c.rt60_s, c.snr_db] == run.spec.nominal)
+            .unwrap_or(0);
+        let a = run.setup.mic(run.stage.robot, 0);
+        let b = run.setup.mic(run.stage.robot, 1);
+        Ok(Loop {
+            cam: Camera::new("camera", CameraModel::Pinhole(model.clone()), 2.0, None, 0),
+            model,
+            laser,
+            laser_pose: run.base() * pose(LASER_XZ[0], 0.0, LASER_XZ[1], 0.0),
+            geometry,
+            system: System::new(params, Modalities::ALL),
+            legs: LegFront::new(TrackerParams::default()),
+            sound: SoundFront::new(&params).map_err(scen)?,
+            faces: FaceDetector::new(FaceParams::default()).map_err(scen)?,
+            params,
+            mic: deinterleave(&run.conditions[nominal].samples),
+            mics: [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, a[2]],
+            truth: truth::TrueAttention::default(),
+            ptu: PanTilt::default(),
+            next_chunk: 0,
+            next_scan: 0,
+            latest: None,
+        })
+    }
+
+    /// Audio chunks that ended by `t`.
+    fn chunks_until(&mut self, run: &Run, w: &mut SessionWriter, ch: &Channels, t: f64) -> Result<(), SynthError> {
+        let fs = f64::from(run.setup.sample_rate);
+        while (self.next_chunk + 1) * CHUNK_FRAMES <= (t * fs).round() as usize {
+            run.write_chunk(w, ch, self.next_chunk)?;
+            self.next_chunk += 1;
+        }
+        Ok(())
+    }
+
+    /// Scans up to `t`, each written and fed to the laser people tracker.
+    fn scans_until(&mut self, run: &Run, w: &mut SessionWriter, ch: &Channels, t: f64) -> Result<(), SynthError> {
+        let spec = &self.laser;
+        loop {
+            let ts = LASER_PHASE_S + self.next_scan as f64 / LASER_RATE_HZ;
+            if ts > t {
+                return Ok(());
+            }
+            let prims = run.scene(ts);
+            let key = rng::hash(run.seed, &[self.next_scan as u64, 0x1a5e]);
+            let (ranges, _) = scan(spec, &self.laser_pose, &[&run.world.statics, &prims], key);
+            let stamp = run.at(ts);
+            w.write(
+                ch.scan,
+                Nanos(stamp.0 + 5_000_000),
+                &LaserScan {
+                    header: Header::new(stamp, "laser"),
+                    angle_min: spec.angle_min() as f32,
+                    angle_max: (spec.angle_min() + (spec.beams() - 1) as f64 * spec.increment) as f32,
+                    angle_increment: spec.increment as f32,
+                    time_increment: 0.0,
+                    scan_time: (1.0 / LASER_RATE_HZ) as f32,
+                    range_min: spec.range_min as f32,
+                    range_max: spec.range_max as f32,
+                    ranges: ranges.clone(),
+                    intensities: Vec::new(),
+                },
+            )?;
+            let ts_logged = (stamp.0 - run.t0.0) as f64 * 1e-9;
+            self.latest = Some(self.legs.scan(ts_logged, &ranges, &self.geometry, Some(&self.laser_pose)));
+            self.next_scan += 1;
+        }
+    }
+
+    /// Camera frame `k` at `t`: render with the unit where it is, write the image, its pose
+    /// and the joint states; the system's step on the decoded JPEG; the attention state and
+    /// the ground truth. The unit turns for the next frame.
+    fn frame(
+        &mut self,
+        run: &Run,
+        w: &mut SessionWriter,
+        ch: &Channels,
+        k: usize,
+        t: f64,
+    ) -> Result<(crate::synth::render::Frame, gt::BironFrame), SynthError> {
+        let stamp = run.at(t);
+        let prims = run.scene(t);
+        let cam_pose = camera_pose(&run.base(), self.ptu);
+        let frame = self.cam.render(&FrameInput {
+            world: run.world,
+            dynamic: &prims,
+            shadows: &[],
+            t,
+            pose: cam_pose,
+            noise_key: rng::hash(run.seed, &[k as u64, 0xca]),
+        });
+        let jpeg = self.write_frame(run, w, ch, &frame, stamp, &cam_pose)?;
+        let rgb = image::load_from_memory_with_format(&jpeg, image::ImageFormat::Jpeg)
+            .map_err(scen)?
+            .to_rgb8();
+        let view = CameraView {
+            model: self.model.clone(),
+            pose: cam_pose,
+        };
+        let rgb_view = ImageView::rgb(&rgb).map_err(scen)?;
+        let grey = grey_from_rgb(rgb_view).map_err(scen)?;
+        let grey_view = ImageView::new(&grey, rgb.width() as usize, rgb.height() as usize, 1).map_err(scen)?;
+        let found = self.faces.detect(grey_view).map_err(scen)?;
+        let bins = BinImage::new(rgb_view, ColorSpace::Hs).map_err(scen)?;
+        let fs = f64::from(run.setup.sample_rate);
+        let block = (self.params.sound_block_s * fs) as usize;
+        let end = (t * fs).round() as usize;
+        let percept = if end >= block && end <= self.mic.0.len() {
+            Some(self.sound.block(t, &self.mic.0[end - block..end], &self.mic.1[end - block..end]).map_err(scen)?)
+        } else {
+            None
+        };
+        let spoken = spoken(run.script, t, 1.0 / run.spec.rate_hz);
+        let out = self.system.step(&StepInput {
+            t,
+            robot: run.stage.robot,
+            mics: self.mics,
+            legs: self.latest.take().as_deref(),
+            view: &view,
+            faces: &found,
+            bins: &bins,
+            sound: percept,
+            spoken: &spoken,
+        });
+        w.write_json(ch.state, Nanos(stamp.0 + 30_000_000), &state_of(&self.system, &out, stamp, t))?;
+        let (people, biron) = self.truth.step(run, t, stamp, &view, &frame.ids);
+        w.write_json(ch.people, stamp, &PeopleFrame { stamp_ns: stamp.0, people })?;
+        w.write_json(ch.biron, stamp, &biron)?;
+        self.ptu = out.ptu;
+        Ok((frame, biron))
+    }
+
+    /// Write a frame's TF, joint states, JPEG and camera info; returns the JPEG bytes.
+    fn write_frame(
+        &self,
+        run: &Run,
+        w: &mut SessionWriter,
+        ch: &Channels,
+        frame: &crate::synth::render::Frame,
+        stamp: Nanos,
+        cam_pose: &Isometry3<f64>,
+    ) -> Result<Vec<u8>, SynthError> {
+        let mut jpeg = Vec::new();
+        image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, JPEG_QUALITY)
+            .encode(&frame.rgb, frame.width, frame.height, image::ExtendedColorType::Rgb8)
+            .map_err(|e| SynthError::Encode {
+                camera: "camera".into(),
+                reason: e.to_string(),
+            })?;
+        let header = Header::new(stamp, "camera_optical");
+        let base_from_optical = run.base().inverse() * cam_pose;
+        let soon = Nanos(stamp.0 + 1_000_000);
+        w.write(
+            ch.tf,
+            soon,
+            &TfMessage {
+                transforms: vec![tf("base_link", "camera_optical", stamp, &base_from_optical)],
+            },
+        )?;
+        w.write(
+            ch.joints,
+            soon,
+            &JointState {
+                header: Header::new(stamp, "base_link"),
+                name: vec!["pan".into(), "tilt".into()],
+                position: vec![self.ptu.pan, self.ptu.tilt],
+                velocity: Vec::new(),
+                effort: Vec::new(),
+            },
+        )?;
+        let log = Nanos(stamp.0 + 15_000_000);
+        w.write(
+            ch.image,
+            log,
+            &CompressedImage {
+                header: header.clone(),
+                format: "jpeg".into(),
+                data: jpeg.clone(),
+            },
+        )?;
+        w.write(ch.info, log, &CameraInfo::from_model(&CameraModel::Pinhole(self.model.clone()), header))?;
+        Ok(jpeg)
     }
 }
 

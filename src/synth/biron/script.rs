@@ -6,7 +6,7 @@
 //! - **Visitors** (2–5): visitor 1 is the *user*; the others stand in front of the robot
 //!   (bearing within ±75°) or behind it (the microphones' mirror side), 1.2–3 m away, for a
 //!   while, and may leave. Paths are [`crate::synth::motion::walk`]s from the door.
-//! - **Utterances**: the user greets ("Hello BIRON") 1.5–3 s after arriving, says 2–4 more
+//! - **Utterances**: the user greets ("Hello BIRON") 1.5–3 s after arriving, says 1–3 more
 //!   things to the robot, then says good-bye (60 %) or walks away without it. The others talk
 //!   to a standing visitor (70 %) or to the robot, every 2–6 s while they stand.
 //! - **Gaze**: a speaker looks at whom they address; a listener addressed by a speaker looks
@@ -243,7 +243,7 @@ fn body(id: u32, rng: &mut ChaCha8Rng) -> Body {
     }
 }
 
-/// The user's lines: greeting, 2–4 more, good-bye (60 %) or walking away.
+/// The user's lines: greeting, 1–3 more (1.5–3 s apart), good-bye (60 %) or walking away.
 fn user_lines(p: &mut Plan, dur: f64, rng: &mut ChaCha8Rng, out: &mut Vec<Utterance>) {
     let mut t = p.arrive + rng.random_range(1.5..3.0);
     let mut say = |t: &mut f64, kind: Kind, rng: &mut ChaCha8Rng| {
@@ -260,10 +260,10 @@ fn user_lines(p: &mut Plan, dur: f64, rng: &mut ChaCha8Rng, out: &mut Vec<Uttera
                 kind,
             });
         }
-        *t += len + rng.random_range(2.0..4.0);
+        *t += len + rng.random_range(1.5..3.0);
     };
     say(&mut t, Kind::Greeting, rng);
-    for _ in 0..rng.random_range(2..=4) {
+    for _ in 0..rng.random_range(1..=3) {
         say(&mut t, Kind::Talk, rng);
     }
     if rng.random::<f64>() < 0.6 {
