@@ -11,7 +11,13 @@
 //! `+τ`. The peak is searched within the physically possible lags `±d/c` and refined by a
 //! parabola through the peak and its two neighbours ([`Refine::Parabolic`]), or left on the
 //! grid ([`Refine::Grid`], for the quantisation bound). The peak height divided by the number
-//! of frame samples is 1 for a pure delay and near 0 for incoherent noise.
+//! of kept bins is 1 for a pure delay and near 0 for incoherent noise.
+//!
+//! With [`GccParams::loud_half`] only the louder half of the block's frames (by the energy of
+//! microphone 0) enters the sum: the syllables, not the pauses between them, where only the
+//! room's noise and reverberation tail are left. Chosen on the quick profile's first session
+//! (nominal condition, 0.5 s single-talker blocks: median error 7.7° against 9.5° with all
+//! frames; anechoic 30 dB: 0.43° against 0.35°).
 //!
 //! FFTs by `realfft`/`rustfft`. Not here: frame-wise tracking, several sources per block.
 
@@ -56,6 +62,8 @@ pub struct GccParams {
     pub band_lo: f64,
     pub band_hi: f64,
     pub refine: Refine,
+    /// Sum only the louder half of the frames (see the module doc).
+    pub loud_half: bool,
 }
 
 impl Default for GccParams {
@@ -72,6 +80,7 @@ impl Default for GccParams {
             band_lo: 200.0,
             band_hi: 6000.0,
             refine: Refine::Parabolic,
+            loud_half: true,
         }
     }
 }
@@ -165,18 +174,29 @@ impl GccPhat {
                 frame: n,
             });
         }
+        let starts: Vec<usize> = (0..)
+            .map(|k| k * self.params.hop)
+            .take_while(|s| s + n <= x0.len())
+            .collect();
+        let energy = |s: usize| x0[s..s + n].iter().map(|v| f64::from(*v).powi(2)).sum::<f64>();
+        let keep: Vec<usize> = if self.params.loud_half && starts.len() > 1 {
+            let mut by: Vec<(f64, usize)> = starts.iter().map(|&s| (energy(s), s)).collect();
+            by.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            let mut k: Vec<usize> = by[..starts.len().div_ceil(2)].iter().map(|x| x.1).collect();
+            k.sort_unstable();
+            k
+        } else {
+            starts
+        };
         let mut sum = vec![Complex::new(0.0, 0.0); n / 2 + 1];
-        let mut frames = 0;
-        let mut start = 0;
-        while start + n <= x0.len() {
+        for &start in &keep {
             self.fft_frame(&x0[start..start + n], true)?;
             self.fft_frame(&x1[start..start + n], false)?;
             for (s, (a, b)) in sum.iter_mut().zip(self.spec0.iter().zip(&self.spec1)) {
                 *s += b * a.conj();
             }
-            frames += 1;
-            start += self.params.hop;
         }
+        let frames = keep.len();
         let bin_hz = self.params.sample_rate / n as f64;
         for (k, s) in sum.iter_mut().enumerate() {
             let f = k as f64 * bin_hz;
@@ -205,7 +225,8 @@ impl GccPhat {
     }
 
     /// The correlation of a PHAT cross-spectrum on the lag grid within `±max_lag_s`: the
-    /// first lag (s), the grid step (s) and the values (divided by the frame length).
+    /// first lag (s), the grid step (s) and the values (divided by the number of kept bins,
+    /// so a pure delay peaks at 1).
     pub fn correlation(
         &mut self,
         cross: &[Complex<f64>],
@@ -224,12 +245,20 @@ impl GccPhat {
         self.c2r
             .process(&mut self.padded, &mut self.corr)
             .map_err(|e| GccError::Fft(e.to_string()))?;
+        // a pure delay sums to 2 per kept bin (its mirror included), 1 at DC and Nyquist
+        let kept: f64 = cross
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.norm() > 0.0)
+            .map(|(k, _)| if k == 0 || k == n / 2 { 1.0 } else { 2.0 })
+            .sum();
+        let scale = kept.max(1.0);
         let step = 1.0 / (self.params.sample_rate * self.params.interp as f64);
         let max_k = ((max_lag_s / step).ceil() as usize).min(big / 2 - 1);
         let values: Vec<f64> = (0..=2 * max_k)
             .map(|i| {
                 let k = i as isize - max_k as isize;
-                self.corr[k.rem_euclid(big as isize) as usize] / n as f64
+                self.corr[k.rem_euclid(big as isize) as usize] / scale
             })
             .collect();
         Ok((-(max_k as f64) * step, step, values))
