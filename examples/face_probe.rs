@@ -49,7 +49,9 @@ fn set(st: &mut FaceStyle, key: &str, v: f64) -> Result<(), String> {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let out = args.first().ok_or("usage: face_probe OUT_DIR [thresh=T] [key=value ...]")?;
+    let out = args
+        .first()
+        .ok_or("usage: face_probe OUT_DIR [thresh=T] [key=value ...]")?;
     std::fs::create_dir_all(out)?;
     let mut style = DEFAULT_STYLE;
     let mut thresh = 2.0;
@@ -69,10 +71,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let style: &'static FaceStyle = Box::leak(Box::new(style));
-    let (s, _) = Scenario::load(std::path::Path::new("datasets/biron_home/scenario.toml"), "quick")?;
+    let (s, _) = Scenario::load(
+        std::path::Path::new("datasets/biron_home/scenario.toml"),
+        "quick",
+    )?;
     let world = World::build(&s, 0);
     let height = width * 3 / 4;
-    let cam = Camera::new("c", CameraModel::Pinhole(Pinhole::from_fov(width, height, 48.8)), 2.0, None, 0);
+    let cam = Camera::new(
+        "c",
+        CameraModel::Pinhole(Pinhole::from_fov(width, height, 48.8)),
+        2.0,
+        None,
+        0,
+    );
     let pose = geometry::pose_xyz_rpy([2.5, 3.0, 1.41], [0.0, 0.0, 0.0])
         * Isometry3::from_parts(Translation3::identity(), geometry::body_from_optical());
     let mut det = FaceDetector::new(FaceParams {
@@ -108,7 +119,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     phase: 0.0,
                 };
                 let mut prims = Vec::new();
-                body.primitives_with_face_style(&st, std::f64::consts::PI + yaw_deg.to_radians(), style, &mut prims);
+                body.primitives_with_face_style(
+                    &st,
+                    std::f64::consts::PI + yaw_deg.to_radians(),
+                    style,
+                    &mut prims,
+                );
                 let f = cam.render(&FrameInput {
                     world: &world,
                     dynamic: &prims,
@@ -134,7 +150,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         .save(format!("{out}/face_{si}_{d}.png"))?;
                 }
             }
-            println!("{line} ({:.2} s per frame)", clock.elapsed().as_secs_f64() / 8.0);
+            println!(
+                "{line} ({:.2} s per frame)",
+                clock.elapsed().as_secs_f64() / 8.0
+            );
         }
     }
     Ok(())

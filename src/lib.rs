@@ -4,8 +4,8 @@
 //! detections and tracks, and evaluation turns tracks into tables and figures. See
 //! `ARCHITECTURE.md` for the map.
 
-pub mod assign;
 pub mod anchoring;
+pub mod assign;
 pub mod audio;
 pub mod calib;
 pub mod eval;

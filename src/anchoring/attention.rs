@@ -161,7 +161,11 @@ mod tests {
         a.step(&[], &[]);
         assert_eq!((a.mode, a.focus), (Mode::Idle, None));
         a.step(&[], &[p(1, 1, 2.0), p(2, 1, 1.5)]);
-        assert_eq!((a.mode, a.focus), (Mode::Alert, Some(2)), "nearest of a tie");
+        assert_eq!(
+            (a.mode, a.focus),
+            (Mode::Alert, Some(2)),
+            "nearest of a tie"
+        );
         a.step(&[], &[p(1, 2, 2.0), p(2, 1, 1.5)]);
         assert_eq!((a.mode, a.focus), (Mode::Alert, Some(1)), "a speaker");
         a.step(&[], &[p(1, 1, 2.0), p(2, 1, 1.5)]);
@@ -181,7 +185,11 @@ mod tests {
         a.step(&[(Command::Greeting, 1)], &[p(1, 3, 2.0), p(2, 1, 1.0)]);
         assert_eq!((a.mode, a.focus), (Mode::Interact, Some(1)));
         a.step(&[], &[p(1, 1, 2.0), p(2, 3, 1.0)]);
-        assert_eq!((a.mode, a.focus), (Mode::Interact, Some(1)), "not distracted");
+        assert_eq!(
+            (a.mode, a.focus),
+            (Mode::Interact, Some(1)),
+            "not distracted"
+        );
         a.step(&[(Command::Goodbye, 2)], &[p(1, 1, 2.0), p(2, 3, 1.0)]);
         assert_eq!(a.mode, Mode::Interact, "only the partner ends it");
         a.step(&[(Command::Goodbye, 1)], &[p(1, 1, 2.0), p(2, 3, 1.0)]);

@@ -258,12 +258,7 @@ impl Fusion {
 
     /// Anchors' torso colour in the frame at `t` (`bins`: the frame binned for the colour
     /// tracker).
-    pub fn torso(
-        &mut self,
-        t: f64,
-        view: &CameraView,
-        bins: &crate::vision::colortrack::BinImage,
-    ) {
+    pub fn torso(&mut self, t: f64, view: &CameraView, bins: &crate::vision::colortrack::BinImage) {
         if !self.modalities.torso {
             return;
         }
@@ -378,7 +373,10 @@ mod tests {
         assert_eq!(f.anchors[1].legs.state(0.1), State::Grounded);
         assert_eq!(f.anchors[1].legs.state(0.5), State::Associated);
         f.prune(2.0);
-        assert!(f.anchors.is_empty(), "every component lost after the legs' 1 s timeout");
+        assert!(
+            f.anchors.is_empty(),
+            "every component lost after the legs' 1 s timeout"
+        );
     }
 
     #[test]
@@ -389,7 +387,10 @@ mod tests {
         let (id, mouth_z) = (f.anchors[0].id, f.anchors[0].mouth_z());
         let el = doa::elevation(mouth_z, mics[2], 2.0);
         let cone = (20f64.to_radians().sin() * el.cos()).asin();
-        assert!(cone.to_degrees() < 19.5, "the raw cone angle is smaller than the azimuth");
+        assert!(
+            cone.to_degrees() < 19.5,
+            "the raw cone angle is smaller than the azimuth"
+        );
         assert_eq!(f.sound(0.0, cone, mics, 0.0), Some(id));
         let (speaking, looking) = f.cues(&f.anchors[0], 0.0);
         assert!(speaking);

@@ -140,9 +140,7 @@ impl SoundFront {
 
     /// The block `x0`, `x1` (microphones 0 and 1) ending at `t`.
     pub fn block(&mut self, t: f64, x0: &[f32], x1: &[f32]) -> Result<SoundPercept, GccError> {
-        let d = self
-            .gcc
-            .delay(x0, x1, GccPhat::max_lag_s(self.spacing_m))?;
+        let d = self.gcc.delay(x0, x1, GccPhat::max_lag_s(self.spacing_m))?;
         let energy = block_energy(x0, x1);
         let active = self.activity.step(t, energy, d.peak);
         Ok(SoundPercept {
@@ -333,7 +331,10 @@ mod tests {
         let mut s = listening();
         let u = [spoken(Some(Command::Greeting), [2.1, 0.1])];
         for k in 10..20 {
-            assert!(s.dialog(f64::from(k) / 10.0, &u).is_empty(), "nothing before the end");
+            assert!(
+                s.dialog(f64::from(k) / 10.0, &u).is_empty(),
+                "nothing before the end"
+            );
         }
         let id = s.fusion.anchors[0].id;
         assert_eq!(s.dialog(2.0, &u), vec![(Command::Greeting, id)]);

@@ -73,6 +73,9 @@ mod tests {
         let d = p - v.origin();
         assert!((az - d.y.atan2(d.x)).abs() < 1e-9);
         assert!((el - d.z.atan2(d.x.hypot(d.y))).abs() < 1e-9);
-        assert!(v.pixel(&Point3::new(-3.0, 2.0, 1.4), 0.0).is_none(), "behind");
+        assert!(
+            v.pixel(&Point3::new(-3.0, 2.0, 1.4), 0.0).is_none(),
+            "behind"
+        );
     }
 }

@@ -103,12 +103,16 @@ mod tests {
     fn a_loud_coherent_block_over_a_quiet_floor_is_active_and_the_floor_forgets() {
         let mut a = Activity::new(ActivityParams::default());
         for k in 0..10 {
-            assert!(!a.step(f64::from(k) * 0.1, 1.0, 0.9), "the first blocks set the floor");
+            assert!(
+                !a.step(f64::from(k) * 0.1, 1.0, 0.9),
+                "the first blocks set the floor"
+            );
         }
         assert_eq!(a.floor(), Some(1.0));
         assert!(a.step(1.0, 4.0, 0.5), "6 dB over the floor");
         assert!(!a.step(1.1, 3.9, 0.5), "just under 6 dB");
-        assert!(!a.step(1.2, 10.0, 0.1), "loud but incoherent");
+        let incoherent = 0.5 * a.params.min_peak;
+        assert!(!a.step(1.2, 10.0, incoherent), "loud but incoherent");
         // the quiet blocks leave the 8 s window: the floor rises to the loud ones
         for k in 0..100 {
             a.step(1.3 + f64::from(k) * 0.1, 10.0, 0.5);

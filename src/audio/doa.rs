@@ -25,7 +25,9 @@ pub const BIRON_MIC_HEIGHT_M: f64 = 1.06;
 /// The cone angle θ (rad) of a delay τ (s) between microphones `spacing_m` apart; a delay
 /// beyond the physical ±d/c (noise) is clamped to ±90°.
 pub fn cone_angle(tau_s: f64, spacing_m: f64) -> f64 {
-    (SPEED_OF_SOUND_M_S * tau_s / spacing_m).clamp(-1.0, 1.0).asin()
+    (SPEED_OF_SOUND_M_S * tau_s / spacing_m)
+        .clamp(-1.0, 1.0)
+        .asin()
 }
 
 /// The delay (s) a far source at azimuth `azimuth` and elevation `elevation` (rad) gives.
@@ -43,7 +45,9 @@ pub fn elevation(mouth_z_m: f64, mic_z_m: f64, range_m: f64) -> f64 {
 /// `asin(sin θ / cos ε)`, clamped to ±90° where the elevation makes the cone miss the
 /// source's height.
 pub fn azimuth(cone: f64, elevation: f64) -> f64 {
-    (cone.sin() / elevation.cos().max(1e-9)).clamp(-1.0, 1.0).asin()
+    (cone.sin() / elevation.cos().max(1e-9))
+        .clamp(-1.0, 1.0)
+        .asin()
 }
 
 /// The mirror of a front azimuth behind the microphone axis: π − φ, wrapped to (−π, π].
@@ -99,11 +103,20 @@ mod tests {
 
     #[test]
     fn the_elevation_correction_recovers_the_azimuth_of_a_raised_mouth() {
-        // a mouth at 1.60 m, 1.5 m away, 40° left: the cone angle is smaller than 40°
+        // a mouth at 1.60 m, 1.5 m away, 40° left: elevation atan(0.54 / 1.5) = 19.80°, and
+        // the cone angle asin(sin 40° · cos 19.80°) = 37.20°, 2.8° short of the azimuth
         let el = elevation(1.60, BIRON_MIC_HEIGHT_M, 1.5);
+        assert!((el - (0.54f64 / 1.5).atan()).abs() < 1e-12);
         let tau = delay_of(40f64.to_radians(), el, BIRON_SPACING_M);
         let cone = cone_angle(tau, BIRON_SPACING_M);
-        assert!(cone < 40f64.to_radians() - 0.05);
+        let want = (40f64.to_radians().sin() * el.cos()).asin();
+        assert!(
+            (cone - want).abs() < 1e-9,
+            "{} vs {}",
+            cone.to_degrees(),
+            want.to_degrees()
+        );
+        assert!((40.0 - cone.to_degrees() - 2.8).abs() < 0.05);
         assert!((azimuth(cone, el) - 40f64.to_radians()).abs() < 1e-12);
     }
 

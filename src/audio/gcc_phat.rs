@@ -119,10 +119,16 @@ impl GccPhat {
             )));
         }
         if p.hop == 0 || p.hop > p.frame {
-            return Err(GccError::Settings(format!("hop {} not in [1, frame]", p.hop)));
+            return Err(GccError::Settings(format!(
+                "hop {} not in [1, frame]",
+                p.hop
+            )));
         }
         if p.interp == 0 || p.interp > 64 {
-            return Err(GccError::Settings(format!("interp {} not in [1, 64]", p.interp)));
+            return Err(GccError::Settings(format!(
+                "interp {} not in [1, 64]",
+                p.interp
+            )));
         }
         if !(p.sample_rate > 0.0 && p.band_lo >= 0.0 && p.band_lo < p.band_hi) {
             return Err(GccError::Settings(
@@ -178,7 +184,12 @@ impl GccPhat {
             .map(|k| k * self.params.hop)
             .take_while(|s| s + n <= x0.len())
             .collect();
-        let energy = |s: usize| x0[s..s + n].iter().map(|v| f64::from(*v).powi(2)).sum::<f64>();
+        let energy = |s: usize| {
+            x0[s..s + n]
+                .iter()
+                .map(|v| f64::from(*v).powi(2))
+                .sum::<f64>()
+        };
         let keep: Vec<usize> = if self.params.loud_half && starts.len() > 1 {
             let mut by: Vec<(f64, usize)> = starts.iter().map(|&s| (energy(s), s)).collect();
             by.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
@@ -234,7 +245,9 @@ impl GccPhat {
     ) -> Result<(f64, f64, Vec<f64>), GccError> {
         let n = self.params.frame;
         let big = n * self.params.interp;
-        self.padded.iter_mut().for_each(|c| *c = Complex::new(0.0, 0.0));
+        self.padded
+            .iter_mut()
+            .for_each(|c| *c = Complex::new(0.0, 0.0));
         for (d, s) in self.padded.iter_mut().zip(cross) {
             *d = *s;
         }

@@ -75,7 +75,11 @@ fn a_source_behind_the_robot_is_read_as_its_mirror_in_front() {
         .delay(block(&x0), block(&x1), GccPhat::max_lag_s(BIRON_SPACING_M))
         .expect("delay");
     let front = doa::azimuth(doa::cone_angle(d.tau_s, BIRON_SPACING_M), 0.0);
-    assert!((front.to_degrees() - 40.0).abs() < 0.1, "{}", front.to_degrees());
+    assert!(
+        (front.to_degrees() - 40.0).abs() < 0.1,
+        "{}",
+        front.to_degrees()
+    );
     assert!((doa::mirror(front) - behind).abs() < 0.1f64.to_radians());
 }
 
@@ -107,12 +111,8 @@ fn integer_lags_alone_err_by_up_to_the_quantisation_bound_and_no_more() {
 #[test]
 fn independent_noise_on_the_two_microphones_gives_a_low_peak() {
     let mut g = GccPhat::new(GccParams::default()).expect("gcc");
-    let x0: Vec<f32> = (0..8000)
-        .map(|i| rng::gauss(rng::hash(1, &[i])))
-        .collect();
-    let x1: Vec<f32> = (0..8000)
-        .map(|i| rng::gauss(rng::hash(2, &[i])))
-        .collect();
+    let x0: Vec<f32> = (0..8000).map(|i| rng::gauss(rng::hash(1, &[i]))).collect();
+    let x1: Vec<f32> = (0..8000).map(|i| rng::gauss(rng::hash(2, &[i]))).collect();
     let d = g
         .delay(&x0, &x1, GccPhat::max_lag_s(BIRON_SPACING_M))
         .expect("delay");

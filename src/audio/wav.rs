@@ -52,7 +52,11 @@ mod tests {
         assert_eq!(u16::from_le_bytes([b[20], b[21]]), 1, "PCM");
         assert_eq!(u16::from_le_bytes([b[22], b[23]]), 2, "channels");
         assert_eq!(u32::from_le_bytes([b[24], b[25], b[26], b[27]]), 16_000);
-        assert_eq!(u32::from_le_bytes([b[28], b[29], b[30], b[31]]), 64_000, "byte rate");
+        assert_eq!(
+            u32::from_le_bytes([b[28], b[29], b[30], b[31]]),
+            64_000,
+            "byte rate"
+        );
         assert_eq!(&b[36..40], b"data");
         let data: Vec<i16> = b[44..]
             .chunks_exact(2)

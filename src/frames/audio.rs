@@ -92,7 +92,12 @@ pub fn read(log: &SessionLog, topic: &str) -> Result<(AudioStream, Skips), LogEr
         if chunk.data.len() % 4 != 0 {
             skips.note(
                 topic,
-                format!("{}: {topic} at {} ns: {} bytes are not whole frames", log.path().display(), m.log_time.0, chunk.data.len()),
+                format!(
+                    "{}: {topic} at {} ns: {} bytes are not whole frames",
+                    log.path().display(),
+                    m.log_time.0,
+                    chunk.data.len()
+                ),
             );
             continue;
         }
@@ -103,11 +108,25 @@ pub fn read(log: &SessionLog, topic: &str) -> Result<(AudioStream, Skips), LogEr
         }
         let have = stream.channels[0].len();
         let Some(at) = stream.index(stamp) else {
-            skips.note(topic, format!("{}: {topic} at {} ns: chunk stamped before the stream's start", log.path().display(), m.log_time.0));
+            skips.note(
+                topic,
+                format!(
+                    "{}: {topic} at {} ns: chunk stamped before the stream's start",
+                    log.path().display(),
+                    m.log_time.0
+                ),
+            );
             continue;
         };
         if at + 1 < have {
-            skips.note(topic, format!("{}: {topic} at {} ns: chunk overlaps the previous one", log.path().display(), m.log_time.0));
+            skips.note(
+                topic,
+                format!(
+                    "{}: {topic} at {} ns: chunk overlaps the previous one",
+                    log.path().display(),
+                    m.log_time.0
+                ),
+            );
             continue;
         }
         if at > have {

@@ -128,16 +128,50 @@ pub fn albedo(
         return skin; // cheeks, ears, jaw seen from the side
     }
     let sa = s.abs();
-    let e = |s0: f64, u0: f64, rs: f64, ru: f64| Ellipse { s: s0, u: u0, rs, ru };
+    let e = |s0: f64, u0: f64, rs: f64, ru: f64| Ellipse {
+        s: s0,
+        u: u0,
+        rs,
+        ru,
+    };
     let mut a = skin;
-    a = mix(a, scale(skin, st.socket_shade), e(st.eye_s, st.eye_u, st.socket_rs, st.socket_ru).cover(sa, u));
-    a = mix(a, [st.white; 3], e(st.eye_s, st.eye_u, st.white_rs, st.white_ru).cover(sa, u));
-    a = mix(a, [0.02, 0.015, 0.012], e(st.eye_s, st.eye_u, st.iris_r, st.iris_r).cover(sa, u));
-    let brow = e(st.eye_s + 0.002, st.eye_u + st.brow_du, st.brow_rs, st.brow_ru);
+    a = mix(
+        a,
+        scale(skin, st.socket_shade),
+        e(st.eye_s, st.eye_u, st.socket_rs, st.socket_ru).cover(sa, u),
+    );
+    a = mix(
+        a,
+        [st.white; 3],
+        e(st.eye_s, st.eye_u, st.white_rs, st.white_ru).cover(sa, u),
+    );
+    a = mix(
+        a,
+        [0.02, 0.015, 0.012],
+        e(st.eye_s, st.eye_u, st.iris_r, st.iris_r).cover(sa, u),
+    );
+    let brow = e(
+        st.eye_s + 0.002,
+        st.eye_u + st.brow_du,
+        st.brow_rs,
+        st.brow_ru,
+    );
     a = mix(a, scale(hair, st.brow_shade), brow.cover(sa, u));
-    a = mix(a, scale(skin, st.nose_shade), e(0.0, st.nose_u, st.nose_rs, st.nose_ru).cover(s, u));
-    a = mix(a, [0.32, 0.08, 0.08], e(0.0, st.lips_u, st.lips_rs, st.lips_ru).cover(s, u));
-    mix(a, [0.05, 0.02, 0.02], e(0.0, st.lips_u, st.lips_rs * 0.9, 0.0018).cover(s, u))
+    a = mix(
+        a,
+        scale(skin, st.nose_shade),
+        e(0.0, st.nose_u, st.nose_rs, st.nose_ru).cover(s, u),
+    );
+    a = mix(
+        a,
+        [0.32, 0.08, 0.08],
+        e(0.0, st.lips_u, st.lips_rs, st.lips_ru).cover(s, u),
+    );
+    mix(
+        a,
+        [0.05, 0.02, 0.02],
+        e(0.0, st.lips_u, st.lips_rs * 0.9, 0.0018).cover(s, u),
+    )
 }
 
 #[cfg(test)]
@@ -149,7 +183,10 @@ mod tests {
 
     /// The point on the head surface straight ahead of its centre at `(s, u)` offsets.
     fn front(center: [f64; 3], yaw: f64, s: f64, u: f64) -> [f64; 3] {
-        let f = 0.1 * (1.0 - (s / 0.085).powi(2) - (u / 0.12).powi(2)).max(0.0).sqrt();
+        let f = 0.1
+            * (1.0 - (s / 0.085).powi(2) - (u / 0.12).powi(2))
+                .max(0.0)
+                .sqrt();
         let (sn, cs) = yaw.sin_cos();
         [
             center[0] + f * cs - s * sn,
@@ -164,7 +201,14 @@ mod tests {
         let st = DEFAULT_STYLE;
         for yaw in [0.0, 1.0, -2.5] {
             for side in [-1.0, 1.0] {
-                let eye = albedo(front(c, yaw, side * st.eye_s, st.eye_u), c, yaw, SKIN, HAIR, &st);
+                let eye = albedo(
+                    front(c, yaw, side * st.eye_s, st.eye_u),
+                    c,
+                    yaw,
+                    SKIN,
+                    HAIR,
+                    &st,
+                );
                 assert!(eye[0] < 0.05, "yaw {yaw}: iris {eye:?}");
             }
             let cheek = albedo(front(c, yaw, 0.04, -0.03), c, yaw, SKIN, HAIR, &st);

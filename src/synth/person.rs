@@ -250,18 +250,7 @@ impl Body {
         );
         let head = self.head_center(s);
         let hairline = head.z + super::face::HAIRLINE_U;
-        let texture = match face {
-            None => Texture::Split {
-                z: hairline as f32,
-                above: linear(self.hair),
-            },
-            Some((yaw, style)) => Texture::Face {
-                center: [head.x as f32, head.y as f32, head.z as f32],
-                yaw: yaw as f32,
-                hair: linear(self.hair),
-                style,
-            },
-        };
+        let texture = self.head_texture(head, hairline, face);
         out.push(
             Primitive::new(
                 Shape::Ellipsoid {
@@ -293,6 +282,27 @@ impl Body {
                 Material::flat(hat),
                 id,
             ));
+        }
+    }
+
+    /// The head's texture: hair above the hairline, or a painted face turned to its yaw.
+    fn head_texture(
+        &self,
+        head: Point3<f64>,
+        hairline: f64,
+        face: Option<(f64, &'static super::face::FaceStyle)>,
+    ) -> Texture {
+        match face {
+            None => Texture::Split {
+                z: hairline as f32,
+                above: linear(self.hair),
+            },
+            Some((yaw, style)) => Texture::Face {
+                center: [head.x as f32, head.y as f32, head.z as f32],
+                yaw: yaw as f32,
+                hair: linear(self.hair),
+                style,
+            },
         }
     }
 

@@ -52,9 +52,6 @@ pub fn write_session(
     path: &Path,
     bar: &dyn Progress,
 ) -> Result<PreviewData, SynthError> {
-    if let Some(spec) = &s.biron {
-        return crate::synth::biron::write_session(s, spec, scenario_text, profile, index, path, bar);
-    }
     let seed = rng::hash(s.scenario.seed, &[u64::from(index)]);
     let session = u64::from(index);
     let world = World::build(s, session);

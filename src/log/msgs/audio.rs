@@ -17,7 +17,9 @@ impl RosMessage for AudioDataStamped {
 
     fn from_value(mut v: Value) -> Result<Self> {
         let header = field(&mut v, "header", Header::from_value)?;
-        let data = field(&mut v, "audio", |mut a| field(&mut a, "data", Value::into_bytes))?;
+        let data = field(&mut v, "audio", |mut a| {
+            field(&mut a, "data", Value::into_bytes)
+        })?;
         Ok(AudioDataStamped { header, data })
     }
 

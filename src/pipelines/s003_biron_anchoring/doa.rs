@@ -141,7 +141,10 @@ pub fn correlogram(
         if end < block || end > s.channels[0].len() {
             continue;
         }
-        let (cross, _) = gcc.cross_spectrum(&s.channels[0][end - block..end], &s.channels[1][end - block..end])?;
+        let (cross, _) = gcc.cross_spectrum(
+            &s.channels[0][end - block..end],
+            &s.channels[1][end - block..end],
+        )?;
         cols.push(gcc.correlation(&cross, max)?);
     }
     let rows = cols.first().map_or(1, |c| c.2.len());
@@ -163,13 +166,20 @@ pub fn correlogram(
         let t0 = s.start.0;
         for k in 1..=steps {
             let t = k as f64 * 0.1;
-            for u in utt.iter().filter(|u| secs(u.start_ns, t0) <= t && t < secs(u.end_ns, t0)) {
+            for u in utt
+                .iter()
+                .filter(|u| secs(u.start_ns, t0) <= t && t < secs(u.end_ns, t0))
+            {
                 let (cone, _) = true_cone(mics, u.mouth);
                 let tau = cone.sin() * BIRON_SPACING_M / crate::audio::SPEED_OF_SOUND_M_S;
                 let j = ((tau - first) / step).round();
                 if j >= 0.0 && (j as usize) < rows {
                     let y = (rows - 1 - j as usize) as u32 * rh;
-                    img.put_pixel(((k - 1) as u32 * cw + 1).min(img.width() - 1), y, Rgb([255, 255, 255]));
+                    img.put_pixel(
+                        ((k - 1) as u32 * cw + 1).min(img.width() - 1),
+                        y,
+                        Rgb([255, 255, 255]),
+                    );
                 }
             }
         }
@@ -183,8 +193,14 @@ mod tests {
 
     #[test]
     fn grid_topics_name_their_condition() {
-        assert_eq!(condition("/audio_grid/rt60_300ms_snr_10db/audio"), Some((300, 10)));
-        assert_eq!(condition("/audio_grid/rt60_0ms_snr_0db/audio"), Some((0, 0)));
+        assert_eq!(
+            condition("/audio_grid/rt60_300ms_snr_10db/audio"),
+            Some((300, 10))
+        );
+        assert_eq!(
+            condition("/audio_grid/rt60_0ms_snr_0db/audio"),
+            Some((0, 0))
+        );
         assert_eq!(condition("/audio"), None);
     }
 

@@ -53,8 +53,12 @@ fn doa_cdf(data: &[SessionData], cells: &[DoaCell]) -> Figure {
             _ => Mark::Points,
         };
         series.push(
-            Series::line(format!("RT60 {} ms, SNR {} dB", c.rt60_ms, c.snr_db), pts, i / 3)
-                .with_mark(mark),
+            Series::line(
+                format!("RT60 {} ms, SNR {} dB", c.rt60_ms, c.snr_db),
+                pts,
+                i / 3,
+            )
+            .with_mark(mark),
         );
     }
     Figure::new(
@@ -96,7 +100,10 @@ fn timeline(s: &SessionData) -> Figure {
     series.push(Series::points("matched person speaks (truth)", speaking, 5));
     Figure::new(
         format!("anchor_timeline_{}", s.name),
-        format!("Person anchors of {} (full system): grounded components per anchor lane, speaking bars", s.name),
+        format!(
+            "Person anchors of {} (full system): grounded components per anchor lane, speaking bars",
+            s.name
+        ),
         FigureKind::Lines(LinePlot {
             x_label: "time (s)".into(),
             y_label: "anchor (lane)".into(),
@@ -108,7 +115,10 @@ fn timeline(s: &SessionData) -> Figure {
 
 fn focus(s: &SessionData) -> Figure {
     let full: Vec<_> = s.steps.iter().filter(|r| r.variant == "full").collect();
-    let est: Vec<(f64, f64)> = full.iter().map(|r| (r.t_s, r.focus_person as f64 + 0.1)).collect();
+    let est: Vec<(f64, f64)> = full
+        .iter()
+        .map(|r| (r.t_s, r.focus_person as f64 + 0.1))
+        .collect();
     let truth: Vec<(f64, f64)> = full.iter().map(|r| (r.t_s, r.true_focus as f64)).collect();
     let top: Vec<(f64, f64)> = full
         .iter()
@@ -122,7 +132,10 @@ fn focus(s: &SessionData) -> Figure {
         .collect();
     Figure::new(
         format!("focus_{}", s.name),
-        format!("Focus of attention in {}: the person the system attends (matched at 0.5 m) and the true focus; -1: nobody; bars: top-down", s.name),
+        format!(
+            "Focus of attention in {}: the person the system attends (matched at 0.5 m) and the true focus; -1: nobody; bars: top-down",
+            s.name
+        ),
         FigureKind::Lines(LinePlot {
             x_label: "time (s)".into(),
             y_label: "person id".into(),
@@ -148,9 +161,18 @@ fn variant_bars(data: &[SessionData]) -> Figure {
             y_label: "share / MOTA".into(),
             groups,
             series: vec![
-                ("speaker identification".into(), rows.iter().map(|r| fin(r.speaker_id)).collect()),
-                ("focus right".into(), rows.iter().map(|r| fin(r.focus_right)).collect()),
-                ("MOTA (0.5 m)".into(), rows.iter().map(|r| fin(r.mota)).collect()),
+                (
+                    "speaker identification".into(),
+                    rows.iter().map(|r| fin(r.speaker_id)).collect(),
+                ),
+                (
+                    "focus right".into(),
+                    rows.iter().map(|r| fin(r.focus_right)).collect(),
+                ),
+                (
+                    "MOTA (0.5 m)".into(),
+                    rows.iter().map(|r| fin(r.mota)).collect(),
+                ),
             ],
             ..GroupedBars::default()
         }),

@@ -101,6 +101,37 @@ impl Experiment for BironAnchoring {
     }
 
     fn aggregate(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
-        aggregate::products(ctx, p)
+        let data = aggregate::load(ctx)?;
+        let mut out = aggregate::products(&data, p)?;
+        out.figures
+            .extend(figures::all(&data, &aggregate::doa_cells(&data)));
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::config;
+
+    #[test]
+    fn the_shipped_pipeline_file_states_the_code_defaults_and_bad_values_are_named() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("pipelines/s003_biron_anchoring.toml");
+        let text = std::fs::read_to_string(&path).expect("pipeline file");
+        let file = config::parse::<Params>(&path, &text).expect("parses");
+        assert!(BironAnchoring::validate(&file.params).is_empty());
+        assert_eq!(file.params, Params::default());
+        let p = Params {
+            rate_hz: 0.0,
+            doa_single_share: 0.2,
+            level: 1.0,
+            ..Params::default()
+        };
+        let named: Vec<String> = BironAnchoring::validate(&p)
+            .into_iter()
+            .map(|(k, _)| k)
+            .collect();
+        assert_eq!(named, ["rate_hz", "doa_single_share", "level"]);
     }
 }

@@ -88,14 +88,46 @@ pub fn validate(p: &Params) -> Vec<Invalid> {
             out.push((key.to_string(), reason.to_string()));
         }
     };
-    check((1.0..=30.0).contains(&p.rate_hz), "rate_hz", "must be in [1, 30] Hz");
-    check((0.1..=5.0).contains(&p.doa_block_s), "doa_block_s", "must be in [0.1, 5] s");
-    check((0.5..=1.0).contains(&p.doa_single_share), "doa_single_share", "must be in [0.5, 1]");
+    check(
+        (1.0..=30.0).contains(&p.rate_hz),
+        "rate_hz",
+        "must be in [1, 30] Hz",
+    );
+    check(
+        (0.1..=5.0).contains(&p.doa_block_s),
+        "doa_block_s",
+        "must be in [0.1, 5] s",
+    );
+    check(
+        (0.5..=1.0).contains(&p.doa_single_share),
+        "doa_single_share",
+        "must be in [0.5, 1]",
+    );
     check(p.mot_max_m > 0.0, "mot_max_m", "must be positive");
-    check(p.face_match_share > 0.0, "face_match_share", "must be positive");
-    check((0.0..=1.0).contains(&p.face_visible_min), "face_visible_min", "must be in [0, 1]");
-    check((0.0..=90.0).contains(&p.frontal_max_deg), "frontal_max_deg", "must be in [0, 90]");
-    check((1.0..=120.0).contains(&p.correlogram_s), "correlogram_s", "must be in [1, 120] s");
-    check(p.level > 0.5 && p.level < 1.0, "level", "must be in (0.5, 1)");
+    check(
+        p.face_match_share > 0.0,
+        "face_match_share",
+        "must be positive",
+    );
+    check(
+        (0.0..=1.0).contains(&p.face_visible_min),
+        "face_visible_min",
+        "must be in [0, 1]",
+    );
+    check(
+        (0.0..=90.0).contains(&p.frontal_max_deg),
+        "frontal_max_deg",
+        "must be in [0, 90]",
+    );
+    check(
+        (1.0..=120.0).contains(&p.correlogram_s),
+        "correlogram_s",
+        "must be in [1, 120] s",
+    );
+    check(
+        p.level > 0.5 && p.level < 1.0,
+        "level",
+        "must be in (0.5, 1)",
+    );
     out
 }

@@ -8,7 +8,6 @@
 use std::collections::BTreeMap;
 
 use super::params::{Params, VARIANTS};
-use super::session::FrameRecord;
 use super::tables::{self as t, FaceRow, MotRow, ReplayRow, SpeakerRow, StepRow, TimelineRow};
 use crate::anchoring::component::State;
 use crate::anchoring::system::{StepOutput, System};
@@ -17,6 +16,7 @@ use crate::frames::truth::Stamped;
 use crate::groundtruth::biron::{AttentionState, BironFrame};
 use crate::report::rows::Rows;
 use crate::run::SessionTables;
+use crate::time::Nanos;
 use crate::vision::faces::Face;
 
 /// One anchor at a step.
@@ -37,6 +37,16 @@ pub struct StepRecord {
     /// The step's sound block was active (`None`: no block yet).
     pub sound_active: Option<bool>,
     pub anchors: Vec<AnchorRecord>,
+}
+
+/// What the pass keeps of a frame for scoring.
+pub struct FrameRecord {
+    pub k: i64,
+    pub t: f64,
+    pub stamp: Nanos,
+    pub truth: Option<BironFrame>,
+    /// Per variant: the step's record.
+    pub variants: Vec<StepRecord>,
 }
 
 /// A variant's record of a step.
@@ -84,7 +94,9 @@ pub fn faces(k: i64, truth: &BironFrame, found: &[Face], p: &Params) -> (Vec<Fac
             width_px: face.width_px,
             yaw_deg: face.yaw_deg,
             visible: face.visible,
-            detected: found.iter().any(|f| matches(f, face.center_px, face.width_px)),
+            detected: found
+                .iter()
+                .any(|f| matches(f, face.center_px, face.width_px)),
         });
     }
     let falses = found
@@ -144,7 +156,10 @@ fn mot_of(frames: &[FrameRecord], v: usize, p: &Params) -> anyhow::Result<(MotRo
         }
     }
     let c = &e.metrics.clear;
-    let top_down = frames.iter().filter(|f| f.variants[v].mode == "interact").count();
+    let top_down = frames
+        .iter()
+        .filter(|f| f.variants[v].mode == "interact")
+        .count();
     let row = MotRow {
         variant: VARIANTS[v].0.to_string(),
         objects: c.num_objects as i64,
@@ -225,7 +240,10 @@ pub fn tables(
                         torso: state_code(a.states[2]),
                         voice: state_code(a.states[3]),
                         category: i64::from(a.category),
-                        speaking: tr.people.iter().any(|q| i64::from(q.id) == person && q.speaking),
+                        speaking: tr
+                            .people
+                            .iter()
+                            .any(|q| i64::from(q.id) == person && q.speaking),
                     });
                 }
             }

@@ -12,20 +12,18 @@ use anyhow::Context;
 use image::RgbImage;
 
 use super::params::{Params, VARIANTS};
-use super::score::{self, StepRecord};
+use super::score::{self, FrameRecord};
 use super::tables::{self as t, FaceFrameRow, FaceRow, SkipRow};
 use crate::anchoring::attention::Command;
-use crate::anchoring::system::{
-    LegFront, SoundFront, Spoken, StepInput, System, SystemParams,
-};
-use crate::anchoring::view::CameraView;
 use crate::anchoring::fusion::LegTrack;
+use crate::anchoring::system::{LegFront, SoundFront, Spoken, StepInput, System, SystemParams};
+use crate::anchoring::view::CameraView;
+use crate::frames::Skips;
 use crate::frames::audio::{self, AudioStream};
 use crate::frames::laser::{LaserOptions, scans};
-use crate::frames::Skips;
 use crate::frames::{camera, truth};
 use crate::geometry::camera::CameraModel;
-use crate::groundtruth::biron::{ATTENTION_TOPIC, BIRON_TOPIC, BironFrame, UTTERANCES_TOPIC, UtteranceTruth};
+use crate::groundtruth::biron::{ATTENTION_TOPIC, BIRON_TOPIC, UTTERANCES_TOPIC, UtteranceTruth};
 use crate::laser::points::ScanGeometry;
 use crate::laser::tracker::TrackerParams;
 use crate::log::msgs::CameraInfo;
@@ -46,16 +44,6 @@ pub struct Topics {
     pub info: String,
 }
 
-/// What the pass keeps of a frame for scoring.
-pub struct FrameRecord {
-    pub k: i64,
-    pub t: f64,
-    pub stamp: Nanos,
-    pub truth: Option<BironFrame>,
-    /// Per variant: the step's record.
-    pub variants: Vec<StepRecord>,
-}
-
 fn first_camera(log: &SessionLog, topic: &str) -> anyhow::Result<crate::geometry::camera::Pinhole> {
     let mut dec = Decoders::new();
     for m in log.messages_on(&[topic])? {
@@ -63,14 +51,22 @@ fn first_camera(log: &SessionLog, topic: &str) -> anyhow::Result<crate::geometry
         let info: CameraInfo = dec.typed(log, &m)?;
         return match info.model()? {
             CameraModel::Pinhole(p) => Ok(p),
-            _ => anyhow::bail!("{}: {topic}: the BIRON camera must be a pinhole", log.path().display()),
+            _ => anyhow::bail!(
+                "{}: {topic}: the BIRON camera must be a pinhole",
+                log.path().display()
+            ),
         };
     }
     anyhow::bail!("{}: no CameraInfo on {topic}", log.path().display())
 }
 
 /// Leg tracks after every scan: `(stamp, tracks)`.
-fn leg_tracks(log: &SessionLog, topic: &str, t0: Nanos, skips: &mut Skips) -> anyhow::Result<Vec<(Nanos, Vec<LegTrack>)>> {
+fn leg_tracks(
+    log: &SessionLog,
+    topic: &str,
+    t0: Nanos,
+    skips: &mut Skips,
+) -> anyhow::Result<Vec<(Nanos, Vec<LegTrack>)>> {
     let opts = LaserOptions {
         fixed_frame: Some("map".into()),
         ..LaserOptions::default()
@@ -108,7 +104,12 @@ fn spoken_at(utt: &[UtteranceTruth], t0: Nanos, t: f64, dt: f64) -> Vec<Spoken> 
 }
 
 /// Process one session into its tables.
-pub fn process(s: &Session, p: &Params, topics: &Topics, bar: &dyn Progress) -> anyhow::Result<SessionTables> {
+pub fn process(
+    s: &Session,
+    p: &Params,
+    topics: &Topics,
+    bar: &dyn Progress,
+) -> anyhow::Result<SessionTables> {
     let log = &s.log;
     let mut skips = Skips::new();
     bar.set_message("audio");
@@ -117,7 +118,11 @@ pub fn process(s: &Session, p: &Params, topics: &Topics, bar: &dyn Progress) -> 
     let t0 = nominal.start;
     let (utter, sk) = truth::utterances(log, UTTERANCES_TOPIC)?;
     skips.merge(sk);
-    let utt: Vec<UtteranceTruth> = utter.iter().next().map(|(_, f)| f.utterances.clone()).unwrap_or_default();
+    let utt: Vec<UtteranceTruth> = utter
+        .iter()
+        .next()
+        .map(|(_, f)| f.utterances.clone())
+        .unwrap_or_default();
     let (gt, sk) = truth::biron(log, BIRON_TOPIC)?;
     skips.merge(sk);
     let (logged, sk) = truth::attention_states(log, ATTENTION_TOPIC)?;
@@ -148,16 +153,25 @@ pub fn process(s: &Session, p: &Params, topics: &Topics, bar: &dyn Progress) -> 
         let t = k as f64 / p.rate_hz;
         let pose = tf
             .lookup("map", "camera_optical", f.stamp)
-            .with_context(|| format!("{}: camera pose at {} ns", log.path().display(), f.stamp.0))?;
+            .with_context(|| {
+                format!("{}: camera pose at {} ns", log.path().display(), f.stamp.0)
+            })?;
         let base = tf.lookup("map", "base_link", f.stamp)?;
         let mic = tf.lookup("map", "microphones", f.stamp)?;
-        let view = CameraView { model: model.clone(), pose };
+        let view = CameraView {
+            model: model.clone(),
+            pose,
+        };
         let found = detect(&mut detector, &f.rgb)?;
         let rgb_view = ImageView::rgb(&f.rgb)?;
         let bins = BinImage::new(rgb_view, ColorSpace::Hs)?;
         let end = (t * fs).round() as usize;
         let percept = if end >= block && end <= nominal.channels[0].len() {
-            Some(sound.block(t, &nominal.channels[0][end - block..end], &nominal.channels[1][end - block..end])?)
+            Some(sound.block(
+                t,
+                &nominal.channels[0][end - block..end],
+                &nominal.channels[1][end - block..end],
+            )?)
         } else {
             None
         };
@@ -191,10 +205,20 @@ pub fn process(s: &Session, p: &Params, topics: &Topics, bar: &dyn Progress) -> 
         }
         if let Some(tr) = &truth_frame {
             let (rows, falses) = score::faces(k, tr, &found, p);
-            face_frames.push(FaceFrameRow { k, detections: found.len() as i64, false_faces: falses });
+            face_frames.push(FaceFrameRow {
+                k,
+                detections: found.len() as i64,
+                false_faces: falses,
+            });
             face_rows.extend(rows);
         }
-        frames.push(FrameRecord { k, t, stamp: f.stamp, truth: truth_frame, variants: records });
+        frames.push(FrameRecord {
+            k,
+            t,
+            stamp: f.stamp,
+            truth: truth_frame,
+            variants: records,
+        });
         bar.inc(1);
     }
     skips.merge(cam.into_skips());
@@ -211,13 +235,20 @@ pub fn process(s: &Session, p: &Params, topics: &Topics, bar: &dyn Progress) -> 
     let doa_rows = super::doa::blocks(&grid, &utt, &mics, p)?;
     out.insert(t::DOA.into(), super::tables::DoaRow::frame(&doa_rows)?);
     let gram: RgbImage = super::doa::correlogram(&nominal, &utt, &mics, p)?;
-    out.insert(t::CORRELOGRAM.into(), crate::report::columns::image_table(&gram)?);
+    out.insert(
+        t::CORRELOGRAM.into(),
+        crate::report::columns::image_table(&gram)?,
+    );
     out.insert(t::FACES.into(), FaceRow::frame(&face_rows)?);
     out.insert(t::FACE_FRAMES.into(), FaceFrameRow::frame(&face_frames)?);
     let skip_rows: Vec<SkipRow> = skips
         .rows()
         .into_iter()
-        .map(|r| SkipRow { topic: r.topic, count: r.count as i64, first_error: r.first_error })
+        .map(|r| SkipRow {
+            topic: r.topic,
+            count: r.count as i64,
+            first_error: r.first_error,
+        })
         .collect();
     out.insert(t::SKIPS.into(), SkipRow::frame(&skip_rows)?);
     Ok(out)
@@ -230,7 +261,10 @@ fn detect(det: &mut FaceDetector, rgb: &RgbImage) -> anyhow::Result<Vec<Face>> {
 }
 
 /// Every acoustic condition's stream (topics under `/audio_grid/`).
-fn grid_streams(log: &SessionLog, skips: &mut Skips) -> anyhow::Result<BTreeMap<String, AudioStream>> {
+fn grid_streams(
+    log: &SessionLog,
+    skips: &mut Skips,
+) -> anyhow::Result<BTreeMap<String, AudioStream>> {
     let mut out = BTreeMap::new();
     let topics: Vec<String> = log
         .summary()

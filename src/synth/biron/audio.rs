@@ -58,7 +58,13 @@ impl AudioSetup {
 }
 
 /// Add `x` convolved with `h` into `out` from sample `at` (FFT convolution).
-fn convolve_into(planner: &mut RealFftPlanner<f64>, x: &[f32], h: &[f32], out: &mut [f64], at: usize) {
+fn convolve_into(
+    planner: &mut RealFftPlanner<f64>,
+    x: &[f32],
+    h: &[f32],
+    out: &mut [f64],
+    at: usize,
+) {
     let len = (x.len() + h.len()).next_power_of_two();
     let fwd = planner.plan_fft_forward(len);
     let inv = planner.plan_fft_inverse(len);
@@ -106,11 +112,18 @@ pub fn render(script: &Script, stage: &Stage, setup: &AudioSetup, seed: u64) -> 
         let level = 10f64.powf(r.random_range(-3.0..3.0) / 20.0);
         let mut x = speech::utterance(&v.voice, u.end - u.start, fs, &mut r);
         x.iter_mut().for_each(|s| *s *= level as f32);
-        dry.push((x, v.mouth(&st, yaw), (u.start * fs) as usize, (u.end * fs) as usize));
+        dry.push((
+            x,
+            v.mouth(&st, yaw),
+            (u.start * fs) as usize,
+            (u.end * fs) as usize,
+        ));
     }
     let mut active = vec![false; n];
     for (_, _, a, b) in &dry {
-        active[(*a).min(n)..(*b).min(n)].iter_mut().for_each(|s| *s = true);
+        active[(*a).min(n)..(*b).min(n)]
+            .iter_mut()
+            .for_each(|s| *s = true);
     }
     let mut noise_rng = ChaCha8Rng::seed_from_u64(rng::hash(seed, &[0x401e]));
     let noise = super::noise::diffuse_pair(n, fs, setup.spacing_m, &mut noise_rng);

@@ -14,7 +14,10 @@ use crate::anchoring::ptu::{CAMERA_HEIGHT_M, PanTilt};
 use crate::anchoring::system::{LegFront, SoundFront, Spoken, StepInput, System, SystemParams};
 use crate::anchoring::view::CameraView;
 use crate::anchoring::{Modalities, fusion::LegTrack};
-use crate::geometry::{self, camera::{CameraModel, Pinhole}};
+use crate::geometry::{
+    self,
+    camera::{CameraModel, Pinhole},
+};
 use crate::groundtruth::biron::{self as gt, AttentionState};
 use crate::groundtruth::{self as gtp, PeopleFrame};
 use crate::laser::points::ScanGeometry;
@@ -151,7 +154,11 @@ impl Run<'_> {
             gt::UTTERANCES_SCHEMA,
             &gt::json_schema(gt::UTTERANCES_SCHEMA),
         )?;
-        w.write_json(utter, self.t0, &truth::utterances(self.script, self.t0, |t| self.at(t)))?;
+        w.write_json(
+            utter,
+            self.t0,
+            &truth::utterances(self.script, self.t0, |t| self.at(t)),
+        )?;
         Ok(Channels {
             tf: w.add_ros2::<TfMessage>("/tf")?,
             scan: w.add_ros2::<LaserScan>("/scan")?,
@@ -163,7 +170,11 @@ impl Run<'_> {
                 gt::ATTENTION_SCHEMA,
                 &gt::json_schema(gt::ATTENTION_SCHEMA),
             )?,
-            people: w.add_json(gtp::PEOPLE_TOPIC, gtp::PEOPLE_SCHEMA, gtp::PEOPLE_JSON_SCHEMA)?,
+            people: w.add_json(
+                gtp::PEOPLE_TOPIC,
+                gtp::PEOPLE_SCHEMA,
+                gtp::PEOPLE_JSON_SCHEMA,
+            )?,
             biron: w.add_json(
                 gt::BIRON_TOPIC,
                 gt::BIRON_SCHEMA,
@@ -185,7 +196,11 @@ impl Run<'_> {
     }
 
     /// Write the whole session (see the module doc); returns the preview of the middle frame.
-    pub fn write(&self, w: &mut SessionWriter, bar: &dyn Progress) -> Result<PreviewData, SynthError> {
+    pub fn write(
+        &self,
+        w: &mut SessionWriter,
+        bar: &dyn Progress,
+    ) -> Result<PreviewData, SynthError> {
         let ch = self.channels(w)?;
         let dur = self.stage.duration;
         let steps = (dur * self.spec.rate_hz).floor() as usize;
@@ -203,10 +218,16 @@ impl Run<'_> {
             bar.inc(1);
         }
         lp.chunks_until(self, w, &ch, dur)?;
-        preview.ok_or_else(|| SynthError::Scenario("a BIRON session needs at least one frame".into()))
+        preview
+            .ok_or_else(|| SynthError::Scenario("a BIRON session needs at least one frame".into()))
     }
 
-    fn write_chunk(&self, w: &mut SessionWriter, ch: &Channels, k: usize) -> Result<(), SynthError> {
+    fn write_chunk(
+        &self,
+        w: &mut SessionWriter,
+        ch: &Channels,
+        k: usize,
+    ) -> Result<(), SynthError> {
         let fs = f64::from(self.setup.sample_rate);
         let stamp = self.at(k as f64 * CHUNK_FRAMES as f64 / fs);
         let log = self.at((k + 1) as f64 * CHUNK_FRAMES as f64 / fs + 0.003);
@@ -322,7 +343,13 @@ impl Loop {
     }
 
     /// Audio chunks that ended by `t`.
-    fn chunks_until(&mut self, run: &Run, w: &mut SessionWriter, ch: &Channels, t: f64) -> Result<(), SynthError> {
+    fn chunks_until(
+        &mut self,
+        run: &Run,
+        w: &mut SessionWriter,
+        ch: &Channels,
+        t: f64,
+    ) -> Result<(), SynthError> {
         let fs = f64::from(run.setup.sample_rate);
         while (self.next_chunk + 1) * CHUNK_FRAMES <= (t * fs).round() as usize {
             run.write_chunk(w, ch, self.next_chunk)?;
@@ -332,7 +359,13 @@ impl Loop {
     }
 
     /// Scans up to `t`, each written and fed to the laser people tracker.
-    fn scans_until(&mut self, run: &Run, w: &mut SessionWriter, ch: &Channels, t: f64) -> Result<(), SynthError> {
+    fn scans_until(
+        &mut self,
+        run: &Run,
+        w: &mut SessionWriter,
+        ch: &Channels,
+        t: f64,
+    ) -> Result<(), SynthError> {
         let spec = &self.laser;
         loop {
             let ts = LASER_PHASE_S + self.next_scan as f64 / LASER_RATE_HZ;
@@ -349,7 +382,8 @@ impl Loop {
                 &LaserScan {
                     header: Header::new(stamp, "laser"),
                     angle_min: spec.angle_min() as f32,
-                    angle_max: (spec.angle_min() + (spec.beams() - 1) as f64 * spec.increment) as f32,
+                    angle_max: (spec.angle_min() + (spec.beams() - 1) as f64 * spec.increment)
+                        as f32,
                     angle_increment: spec.increment as f32,
                     time_increment: 0.0,
                     scan_time: (1.0 / LASER_RATE_HZ) as f32,
@@ -360,7 +394,11 @@ impl Loop {
                 },
             )?;
             let ts_logged = (stamp.0 - run.t0.0) as f64 * 1e-9;
-            self.latest = Some(self.legs.scan(ts_logged, &ranges, &self.geometry, Some(&self.laser_pose)));
+            self.latest =
+                Some(
+                    self.legs
+                        .scan(ts_logged, &ranges, &self.geometry, Some(&self.laser_pose)),
+                );
             self.next_scan += 1;
         }
     }
@@ -397,14 +435,23 @@ impl Loop {
         };
         let rgb_view = ImageView::rgb(&rgb).map_err(scen)?;
         let grey = grey_from_rgb(rgb_view).map_err(scen)?;
-        let grey_view = ImageView::new(&grey, rgb.width() as usize, rgb.height() as usize, 1).map_err(scen)?;
+        let grey_view =
+            ImageView::new(&grey, rgb.width() as usize, rgb.height() as usize, 1).map_err(scen)?;
         let found = self.faces.detect(grey_view).map_err(scen)?;
         let bins = BinImage::new(rgb_view, ColorSpace::Hs).map_err(scen)?;
         let fs = f64::from(run.setup.sample_rate);
         let block = (self.params.sound_block_s * fs) as usize;
         let end = (t * fs).round() as usize;
         let percept = if end >= block && end <= self.mic.0.len() {
-            Some(self.sound.block(t, &self.mic.0[end - block..end], &self.mic.1[end - block..end]).map_err(scen)?)
+            Some(
+                self.sound
+                    .block(
+                        t,
+                        &self.mic.0[end - block..end],
+                        &self.mic.1[end - block..end],
+                    )
+                    .map_err(scen)?,
+            )
         } else {
             None
         };
@@ -420,9 +467,22 @@ impl Loop {
             sound: percept,
             spoken: &spoken,
         });
-        w.write_json(ch.state, Nanos(stamp.0 + 30_000_000), &state_of(&self.system, &out, stamp, t))?;
-        let (people, biron) = self.truth.step(run, t, stamp, &view, &frame.ids);
-        w.write_json(ch.people, stamp, &PeopleFrame { stamp_ns: stamp.0, people })?;
+        w.write_json(
+            ch.state,
+            Nanos(stamp.0 + 30_000_000),
+            &state_of(&self.system, &out, stamp, t),
+        )?;
+        let (people, biron) = self
+            .truth
+            .step(run.script, run.stage, t, stamp, &view, &frame.ids);
+        w.write_json(
+            ch.people,
+            stamp,
+            &PeopleFrame {
+                stamp_ns: stamp.0,
+                people,
+            },
+        )?;
         w.write_json(ch.biron, stamp, &biron)?;
         self.ptu = out.ptu;
         Ok((frame, biron))
@@ -440,7 +500,12 @@ impl Loop {
     ) -> Result<Vec<u8>, SynthError> {
         let mut jpeg = Vec::new();
         image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, JPEG_QUALITY)
-            .encode(&frame.rgb, frame.width, frame.height, image::ExtendedColorType::Rgb8)
+            .encode(
+                &frame.rgb,
+                frame.width,
+                frame.height,
+                image::ExtendedColorType::Rgb8,
+            )
             .map_err(|e| SynthError::Encode {
                 camera: "camera".into(),
                 reason: e.to_string(),
@@ -476,15 +541,28 @@ impl Loop {
                 data: jpeg.clone(),
             },
         )?;
-        w.write(ch.info, log, &CameraInfo::from_model(&CameraModel::Pinhole(self.model.clone()), header))?;
+        w.write(
+            ch.info,
+            log,
+            &CameraInfo::from_model(&CameraModel::Pinhole(self.model.clone()), header),
+        )?;
         Ok(jpeg)
     }
 }
 
 /// The two channels of interleaved samples as floats in [−1, 1).
 pub fn deinterleave(samples: &[i16]) -> (Vec<f32>, Vec<f32>) {
-    let l = samples.iter().step_by(2).map(|&s| f32::from(s) / 32768.0).collect();
-    let r = samples.iter().skip(1).step_by(2).map(|&s| f32::from(s) / 32768.0).collect();
+    let l = samples
+        .iter()
+        .step_by(2)
+        .map(|&s| f32::from(s) / 32768.0)
+        .collect();
+    let r = samples
+        .iter()
+        .skip(1)
+        .step_by(2)
+        .map(|&s| f32::from(s) / 32768.0)
+        .collect();
     (l, r)
 }
 

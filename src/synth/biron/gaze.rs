@@ -36,20 +36,16 @@ pub fn plan_heads(script: &mut Script, st: &Stage, rng: &mut ChaCha8Rng) {
         for (i, s) in v.track.samples.iter().enumerate() {
             let t = v.track.start + i as f64 * DT;
             let me = [s[0], s[1]];
-            let pos = |j: usize| {
-                script.visitors[j]
-                    .track
-                    .state(t)
-                    .map(|p| [p.x, p.y])
-            };
+            let pos = |j: usize| script.visitors[j].track.state(t).map(|p| [p.x, p.y]);
             let to_robot = bearing(me, [st.camera[0], st.camera[1]]);
             let speaking = script
                 .utterances
                 .iter()
                 .find(|u| u.speaker == ids[k] && u.start <= t && t < u.end);
-            let addressed = script.utterances.iter().find(|u| {
-                u.addressee == Addressee::Person(ids[k]) && u.start <= t && t < u.end
-            });
+            let addressed = script
+                .utterances
+                .iter()
+                .find(|u| u.addressee == Addressee::Person(ids[k]) && u.start <= t && t < u.end);
             if t >= next_idle {
                 let r: f64 = rng.random();
                 let others: Vec<usize> = (0..n).filter(|&j| j != k && pos(j).is_some()).collect();

@@ -104,7 +104,8 @@ pub fn write_session(
         duration: s.scenario.duration_s,
     };
     let mut r = ChaCha8Rng::seed_from_u64(rng::hash(seed, &[0xb140]));
-    let script = script::draw(&stage, spec.visitors, &mut r);
+    let mut script = script::draw(&stage, spec.visitors, &mut r);
+    gaze::plan_heads(&mut script, &stage, &mut r);
     let setup = audio::AudioSetup {
         sample_rate: 16_000,
         spacing_m: crate::audio::doa::BIRON_SPACING_M,

@@ -88,8 +88,14 @@ mod tests {
         let (mut s00, mut s11) = (vec![0.0; bins], vec![0.0; bins]);
         let mut s01 = vec![Complex::new(0.0, 0.0); bins];
         for blk in 0..256 {
-            let mut a: Vec<f64> = x0[blk * 512..(blk + 1) * 512].iter().map(|&v| f64::from(v)).collect();
-            let mut b: Vec<f64> = x1[blk * 512..(blk + 1) * 512].iter().map(|&v| f64::from(v)).collect();
+            let mut a: Vec<f64> = x0[blk * 512..(blk + 1) * 512]
+                .iter()
+                .map(|&v| f64::from(v))
+                .collect();
+            let mut b: Vec<f64> = x1[blk * 512..(blk + 1) * 512]
+                .iter()
+                .map(|&v| f64::from(v))
+                .collect();
             let (mut fa, mut fb) = (fwd.make_output_vec(), fwd.make_output_vec());
             fwd.process(&mut a, &mut fa).expect("fft");
             fwd.process(&mut b, &mut fb).expect("fft");
@@ -103,7 +109,10 @@ mod tests {
             let k = (f / fs * 512.0) as usize;
             let measured = s01[k].re / (s00[k] * s11[k]).sqrt();
             let want = diffuse_coherence(k as f64 * fs / 512.0, d);
-            assert!((measured - want).abs() < 0.15, "{f} Hz: {measured} vs {want}");
+            assert!(
+                (measured - want).abs() < 0.15,
+                "{f} Hz: {measured} vs {want}"
+            );
         }
         let p0 = x0.iter().map(|v| f64::from(*v).powi(2)).sum::<f64>() / x0.len() as f64;
         assert!((p0 - 1.0).abs() < 0.1, "{p0}");

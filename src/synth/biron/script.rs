@@ -110,7 +110,12 @@ const CLOTHES: [Rgb; 8] = [
     [30, 30, 35],
     [200, 110, 50],
 ];
-const SKINS: [Rgb; 4] = [[224, 172, 140], [198, 140, 105], [150, 100, 70], [236, 190, 160]];
+const SKINS: [Rgb; 4] = [
+    [224, 172, 140],
+    [198, 140, 105],
+    [150, 100, 70],
+    [236, 190, 160],
+];
 const HAIRS: [Rgb; 4] = [[60, 42, 30], [20, 15, 10], [150, 110, 60], [110, 70, 40]];
 
 fn wrap(a: f64) -> f64 {
@@ -121,10 +126,13 @@ fn wrap(a: f64) -> f64 {
 fn spot(st: &Stage, bearing: f64, range: f64) -> [f64; 2] {
     let a = st.robot[2] + bearing;
     let p = [st.robot[0] + range * a.cos(), st.robot[1] + range * a.sin()];
-    [p[0].clamp(0.5, st.room[0] - 0.5), p[1].clamp(0.5, st.room[1] - 0.5)]
+    [
+        p[0].clamp(0.5, st.room[0] - 0.5),
+        p[1].clamp(0.5, st.room[1] - 0.5),
+    ]
 }
 
-/// Draw the script of one session.
+/// Draw the script of one session; the heads stay empty until `gaze::plan_heads` fills them.
 pub fn draw(st: &Stage, n_range: [u32; 2], rng: &mut ChaCha8Rng) -> Script {
     let n = rng.random_range(n_range[0]..=n_range[1]).max(1);
     let dur = st.duration;
@@ -195,10 +203,7 @@ pub fn draw(st: &Stage, n_range: [u32; 2], rng: &mut ChaCha8Rng) -> Script {
     }
     others_lines(&plans, dur, rng, &mut utterances);
     utterances.sort_by(|a, b| a.start.total_cmp(&b.start));
-    let tracks: Vec<Track> = plans
-        .iter()
-        .map(|p| path(st, p, dur, rng))
-        .collect();
+    let tracks: Vec<Track> = plans.iter().map(|p| path(st, p, dur, rng)).collect();
     let visitors: Vec<Visitor> = visitors
         .into_iter()
         .zip(tracks)
@@ -209,12 +214,10 @@ pub fn draw(st: &Stage, n_range: [u32; 2], rng: &mut ChaCha8Rng) -> Script {
             head: Vec::new(),
         })
         .collect();
-    let mut script = Script {
+    Script {
         visitors,
         utterances,
-    };
-    super::gaze::plan_heads(&mut script, st, rng);
-    script
+    }
 }
 
 /// A visitor's plan: where they stand and when they are there.

@@ -43,7 +43,8 @@ struct Resonator {
 impl Resonator {
     fn step(&mut self, x: f64, f_hz: f64, bw_hz: f64, fs: f64) -> f64 {
         let c = -(-2.0 * std::f64::consts::PI * bw_hz / fs).exp();
-        let b = 2.0 * (-std::f64::consts::PI * bw_hz / fs).exp()
+        let b = 2.0
+            * (-std::f64::consts::PI * bw_hz / fs).exp()
             * (2.0 * std::f64::consts::PI * f_hz / fs).cos();
         let a = 1.0 - b - c;
         let y = a * x + b * self.y1 + c * self.y2;
@@ -163,7 +164,10 @@ mod tests {
     use rand::SeedableRng;
 
     fn zero_crossings_per_s(x: &[f32], fs: f64) -> f64 {
-        let z = x.windows(2).filter(|w| (w[0] < 0.0) != (w[1] < 0.0)).count();
+        let z = x
+            .windows(2)
+            .filter(|w| (w[0] < 0.0) != (w[1] < 0.0))
+            .count();
         z as f64 / (x.len() as f64 / fs)
     }
 
@@ -181,7 +185,10 @@ mod tests {
         assert_eq!(a, mk());
         assert_eq!(a.len(), 32_000);
         // silent gaps between syllables
-        let silent = a.chunks(160).filter(|c| c.iter().all(|v| *v == 0.0)).count();
+        let silent = a
+            .chunks(160)
+            .filter(|c| c.iter().all(|v| *v == 0.0))
+            .count();
         assert!(silent >= 3, "{silent} silent 10 ms blocks");
         let voiced: Vec<f64> = a
             .chunks(160)

@@ -11,12 +11,13 @@
 
 use nalgebra::Point3;
 
-use super::closed_loop::Run;
-use super::script::{Addressee, Kind, Script, bearing, looks_at};
+use super::script::{Addressee, Kind, Script, Stage, bearing, looks_at};
 use crate::anchoring::attention::{Attention, Command, Observed, category};
 use crate::anchoring::view::CameraView;
 use crate::groundtruth::PersonTruth;
-use crate::groundtruth::biron::{BironFrame, BironPerson, FaceTruth, UtteranceTruth, UtterancesFrame};
+use crate::groundtruth::biron::{
+    BironFrame, BironPerson, FaceTruth, UtteranceTruth, UtterancesFrame,
+};
 use crate::synth::person::HEAD_HALF_HEIGHT;
 use crate::time::Nanos;
 
@@ -81,14 +82,13 @@ impl TrueAttention {
     /// The ground truth at step `t`: `/ground_truth/people` and `/ground_truth/biron`.
     pub fn step(
         &mut self,
-        run: &Run,
+        script: &Script,
+        st: &Stage,
         t: f64,
         stamp: Nanos,
         view: &CameraView,
         ids: &[u32],
     ) -> (Vec<PersonTruth>, BironFrame) {
-        let script = run.script;
-        let st = run.stage;
         let mut people = Vec::new();
         let mut persons = Vec::new();
         for v in &script.visitors {
@@ -107,7 +107,9 @@ impl TrueAttention {
                 [st.camera[0], st.camera[1]],
                 LOOK_TOLERANCE_DEG.to_radians(),
             );
-            let rel = crate::audio::doa::wrap(bearing([st.robot[0], st.robot[1]], [s.x, s.y]) - st.robot[2]);
+            let rel = crate::audio::doa::wrap(
+                bearing([st.robot[0], st.robot[1]], [s.x, s.y]) - st.robot[2],
+            );
             let range = (s.x - st.robot[0]).hypot(s.y - st.robot[1]);
             let in_region = rel.abs() <= std::f64::consts::FRAC_PI_2 && range <= REGION_M;
             let cat = category(speaking_u.is_some(), Some(looking));
@@ -118,7 +120,9 @@ impl TrueAttention {
                 mouth: v.mouth(&s, yaw),
                 head_yaw_deg: yaw.to_degrees(),
                 speaking: speaking_u.is_some(),
-                addressee: speaking_u.map(|u| addressee(u.addressee)).unwrap_or_default(),
+                addressee: speaking_u
+                    .map(|u| addressee(u.addressee))
+                    .unwrap_or_default(),
                 looking_at_robot: looking,
                 in_region,
                 category: cat,
@@ -187,7 +191,13 @@ impl TrueAttention {
 
 /// What the camera shows of a head: its projected centre and width, the face's angle away
 /// from the camera, and the share of the head's box with this person's pixels.
-fn face(view: &CameraView, head: Point3<f64>, yaw: f64, object: u32, ids: &[u32]) -> Option<FaceTruth> {
+fn face(
+    view: &CameraView,
+    head: Point3<f64>,
+    yaw: f64,
+    object: u32,
+    ids: &[u32],
+) -> Option<FaceTruth> {
     let px = view.pixel(&head, 0.0)?;
     let o = view.origin();
     let dist = (head - o).norm();
@@ -211,6 +221,10 @@ fn face(view: &CameraView, head: Point3<f64>, yaw: f64, object: u32, ids: &[u32]
         center_px: px,
         width_px: width,
         yaw_deg,
-        visible: if all > 0 { mine as f64 / all as f64 } else { 0.0 },
+        visible: if all > 0 {
+            mine as f64 / all as f64
+        } else {
+            0.0
+        },
     })
 }

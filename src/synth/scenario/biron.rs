@@ -46,8 +46,7 @@ impl BironSpec {
         if !self.rt60_s.contains(&self.nominal[0]) || !self.snr_db.contains(&self.nominal[1]) {
             return bad("nominal", "must be a cell of rt60_s x snr_db");
         }
-        if self.camera[0] < 32 || self.camera[1] < 32 || !(10.0..=120.0).contains(&self.hfov_deg)
-        {
+        if self.camera[0] < 32 || self.camera[1] < 32 || !(10.0..=120.0).contains(&self.hfov_deg) {
             return bad("camera", "needs at least 32x32 px and 10-120 deg");
         }
         if !(1.0..=30.0).contains(&self.rate_hz) {
