@@ -5,7 +5,7 @@ VENV := target/py-venv
 # py-motmetrics needs numpy 1, OpenCV 4.12 numpy 2: separate throwaway environments
 VENV_MOT := target/py-venv-mot
 
-.PHONY: help eval datasets release test bench interop clean opencv-agreement stonesoup-agreement bench-gmm bench-multicam bench-laser wildtrack
+.PHONY: help eval datasets release test bench interop audio-interop clean opencv-agreement stonesoup-agreement bench-gmm bench-multicam bench-laser wildtrack
 
 PROFILE ?= quick
 
@@ -17,6 +17,7 @@ help:
 	@echo "make bench     criterion benchmarks + the same reads in Python mcap-ros2-support, with ratios"
 	@echo "make bench-mot tracking metrics: criterion on a synthetic sequence + py-motmetrics on the same files, with the ratio"
 	@echo "make interop   check that Python mcap-ros2-support opens what we write, synthetic datasets included (throwaway venv)"
+	@echo "make audio-interop  read the BIRON audio back with Python mcap-ros2-support: a fixture and a biron_home session, samples equal (throwaway venv)"
 	@echo "make opencv-agreement  pixel agreement of vision::gmm masks with OpenCV MOG2, fails below 100 % (throwaway venv)"
 	@echo "make stonesoup-agreement  seed 001's PDAF (CV, CT) and IMM step by step against Stone Soup on real and synthetic scans, fails above 1e-9 (throwaway venv)"
 	@echo "make bench-mlp         appearance-model training (10 splits) beside scikit-learn MLPRegressor, with the ratio"
@@ -59,6 +60,15 @@ interop: $(VENV)/ok
 	$(VENV)/bin/python tools/check_mcap_ros2.py target/interop/fixture.mcap target/interop/expected.json
 	$(MAKE) datasets
 	$(VENV)/bin/python tools/check_synth_ros2.py ./target/release/peopletrack datasets/*/*.mcap
+
+# Issue 33: the two-microphone audio (audio_common_msgs) read back by mcap-ros2-support, sample
+# for sample: a fixture of known samples, then a biron_home session against its `peopletrack wav`.
+audio-interop: $(VENV)/ok release
+	$(CARGO) run --quiet --release --example audio_fixture -- target/interop/audio.mcap target/interop/audio_expected.json
+	$(VENV)/bin/python tools/check_audio_ros2.py fixture target/interop/audio.mcap target/interop/audio_expected.json
+	./target/release/peopletrack synth --if-absent datasets/biron_home/scenario.toml
+	./target/release/peopletrack wav datasets/biron_home/biron_home_00.mcap --topic /audio -o target/interop/biron_home_00.wav
+	$(VENV)/bin/python tools/check_audio_ros2.py wav datasets/biron_home/biron_home_00.mcap /audio target/interop/biron_home_00.wav
 
 bench: $(VENV)/ok
 	$(CARGO) bench --bench render -- --noplot

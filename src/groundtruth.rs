@@ -6,6 +6,8 @@
 
 use serde::{Deserialize, Serialize};
 
+pub mod biron;
+
 pub const PEOPLE_TOPIC: &str = "/ground_truth/people";
 pub const PEOPLE_SCHEMA: &str = "peopletrack.PeopleGroundTruth";
 pub const TARGETS_TOPIC: &str = "/ground_truth/calibration_targets";

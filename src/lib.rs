@@ -4,7 +4,9 @@
 //! detections and tracks, and evaluation turns tracks into tables and figures. See
 //! `ARCHITECTURE.md` for the map.
 
+pub mod anchoring;
 pub mod assign;
+pub mod audio;
 pub mod calib;
 pub mod eval;
 pub mod frames;

@@ -29,7 +29,8 @@ const MAX_FN_LINES: usize = 150;
 /// 2. `log` (session files; uses `time`, `geometry` for `CameraInfo` ↔ `CameraModel`);
 /// 3. `frames` (sensor frames decoded from a log, ground truth joined);
 /// 4. the stages' algorithms, which may share a layer: `calib`, `learn`, `vision`, `track`,
-///    `laser`;
+///    `laser`, `audio` (two-microphone delays and directions), `anchoring` (seed 003's
+///    multi-modal person anchors and attention: imports `laser`, `vision`, `audio`, `track`);
 /// 5. `eval` (metrics and statistics: pure functions of data);
 /// 6. `synth` (writes logs through `log`; returns the preview's data, draws nothing);
 /// 7. `report` (tables, figures, the preview sheet drawn from `synth`'s data, atomic writes);
@@ -41,7 +42,15 @@ const LAYERS: &[&[&str]] = &[
     &["geometry", "groundtruth"],
     &["log"],
     &["frames"],
-    &["calib", "learn", "vision", "track", "laser"],
+    &[
+        "calib",
+        "learn",
+        "vision",
+        "track",
+        "laser",
+        "audio",
+        "anchoring",
+    ],
     &["eval"],
     &["synth"],
     &["report"],

@@ -12,6 +12,7 @@ pub mod score;
 pub mod submit;
 pub mod synth;
 pub mod train;
+pub mod wav;
 
 use std::io::{self, Write};
 use std::process::ExitCode;
@@ -71,6 +72,9 @@ pub enum Command {
     /// Run one pipeline on a Slurm cluster: an array of shards, then the aggregate, e.g.
     /// `peopletrack submit --slurm pipelines/laser_people.toml --shards 16`.
     Submit(submit::Args),
+    /// Write a session's two-microphone audio as a WAV file to listen to, e.g.
+    /// `peopletrack wav datasets/biron_home/biron_home_00.mcap -o biron.wav`.
+    Wav(wav::Args),
 }
 
 /// Parse arguments, run the command, and map the outcome to an exit code:
@@ -103,6 +107,7 @@ pub fn main() -> ExitCode {
         Command::Train(a) => train::run(a, &mut out),
         Command::Import(a) => import::run(a, &mut out),
         Command::Submit(a) => submit::run(a, &mut out),
+        Command::Wav(a) => wav::run(a, &mut out),
     }
     .and_then(|()| out.flush().map_err(anyhow::Error::from));
     // this process's scratch folders (empty once every write is done) go

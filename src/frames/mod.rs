@@ -62,6 +62,7 @@
 //!   sorted result); images stay undecoded in [`MultiFrame`] so cameras decode in parallel.
 //! - s000 (which fails on the first bad message): check `skips().first_error()` and bail.
 
+pub mod audio;
 pub mod camera;
 pub mod laser;
 pub mod motion;

@@ -5,6 +5,7 @@
 //! ties to the earlier one).
 
 use super::skips::Skips;
+use crate::groundtruth::biron::{AttentionState, BironFrame, UtterancesFrame};
 use crate::groundtruth::{PeopleFrame, TargetsFrame};
 use crate::log::fast::Decoded;
 use crate::log::value::FieldError;
@@ -98,6 +99,27 @@ fn read_json<T: serde::de::DeserializeOwned>(
 /// The people frames of `topic` (normally [`crate::groundtruth::PEOPLE_TOPIC`]).
 pub fn people(log: &SessionLog, topic: &str) -> Result<(Stamped<PeopleFrame>, Skips), LogError> {
     read_json(log, topic, |f: &PeopleFrame| f.stamp_ns)
+}
+
+/// The BIRON ground truth of `topic` ([`crate::groundtruth::biron::BIRON_TOPIC`]).
+pub fn biron(log: &SessionLog, topic: &str) -> Result<(Stamped<BironFrame>, Skips), LogError> {
+    read_json(log, topic, |f: &BironFrame| f.stamp_ns)
+}
+
+/// The BIRON utterance lists of `topic` ([`crate::groundtruth::biron::UTTERANCES_TOPIC`]).
+pub fn utterances(
+    log: &SessionLog,
+    topic: &str,
+) -> Result<(Stamped<UtterancesFrame>, Skips), LogError> {
+    read_json(log, topic, |f: &UtterancesFrame| f.stamp_ns)
+}
+
+/// A robot's logged attention states of `topic` ([`crate::groundtruth::biron::ATTENTION_TOPIC`]).
+pub fn attention_states(
+    log: &SessionLog,
+    topic: &str,
+) -> Result<(Stamped<AttentionState>, Skips), LogError> {
+    read_json(log, topic, |f: &AttentionState| f.stamp_ns)
 }
 
 /// The calibration targets of `topic` (normally [`crate::groundtruth::TARGETS_TOPIC`]).

@@ -147,6 +147,23 @@ const DEFINITIONS: &[(&str, &str)] = &[
          string mesh_resource\nbool mesh_use_embedded_materials\n",
     ),
     ("visualization_msgs/msg/MarkerArray", "Marker[] markers\n"),
+    // ros-drivers `audio_common` (the `audio_capture` layout; not the incompatible package of
+    // the same name whose AudioData holds one array per sample type)
+    ("audio_common_msgs/msg/AudioData", "uint8[] data\n"),
+    (
+        "audio_common_msgs/msg/AudioDataStamped",
+        "std_msgs/Header header\naudio_common_msgs/AudioData audio\n",
+    ),
+    (
+        "audio_common_msgs/msg/AudioInfo",
+        "uint8 channels\nuint32 sample_rate\nstring sample_format\nuint32 bitrate\n\
+         string coding_format\n",
+    ),
+    (
+        "sensor_msgs/msg/JointState",
+        "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\n\
+         float64[] effort\n",
+    ),
 ];
 
 const SEPARATOR: &str =

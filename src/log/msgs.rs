@@ -141,10 +141,12 @@ pub(crate) fn each<T>(v: Value, f: impl Fn(Value) -> Result<T>) -> Result<Vec<T>
         .collect()
 }
 
+mod audio;
 mod geometry;
 mod sensors;
 mod vision;
 
+pub use audio::{AudioDataStamped, AudioInfo, JointState};
 pub use geometry::{
     Odometry, Pose, PoseArray, PoseStamped, TfMessage, Transform, TransformStamped,
 };

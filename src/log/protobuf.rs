@@ -388,5 +388,8 @@ ros_only!(
     msgs::PoseArray,
     msgs::Detection2DArray,
     msgs::MarkerArray,
+    msgs::AudioDataStamped,
+    msgs::AudioInfo,
+    msgs::JointState,
     TransformStamped
 );

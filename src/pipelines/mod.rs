@@ -6,6 +6,7 @@ pub mod laser_people;
 pub mod s000_cielniak_omni;
 pub mod s001_kobilarov_following;
 pub mod s002_brooks_height;
+pub mod s003_biron_anchoring;
 pub mod s003_zivkovic_background;
 pub mod s004_mohedano_multicam;
 
@@ -53,6 +54,7 @@ registry!(
     s000_cielniak_omni::OmniAppearance,
     s001_kobilarov_following::KobilarovFollowing,
     s002_brooks_height::BrooksHeight,
+    s003_biron_anchoring::BironAnchoring,
     s003_zivkovic_background::BackgroundTracking,
     s004_mohedano_multicam::MulticamCylinders,
 );

@@ -9,11 +9,15 @@
 //! - [`render`]: per-pixel ray casting for every camera model; [`laser`]: scans.
 //! - [`session`]: one session written as a log, returning what its preview sheet shows
 //!   ([`PreviewData`]; `report::preview` draws the sheet — the synthesizer draws nothing).
+//! - [`biron`]: seed 003's BIRON home tour (`[biron]` scenarios): visitors, two-microphone
+//!   audio, faces ([`face`]), and the pan-tilt camera in closed loop with the attention system.
 //! - [`rng`]: seeded randomness.
 //!
 //! Not modelled: global illumination, cast shadows other than soft floor shadows under people,
 //! motion blur, rolling shutter, lens vignetting.
 
+pub mod biron;
+pub mod face;
 pub mod follow;
 pub mod laser;
 pub mod motion;
@@ -82,8 +86,15 @@ pub fn synthesize(scenario_path: &Path, opts: &SynthOptions) -> anyhow::Result<S
         .map(|k| {
             let path = out.join(format!("{}_{:02}.mcap", s.scenario.name, k));
             let bar = bars.bar(&format!("{} {k}", s.scenario.name), "sensor frames");
-            let preview =
-                session::write_session(&s, &text, &opts.profile, &base, k, &path, bar.as_ref())?;
+            // a `[biron]` scenario has its own session writer (seed 003's BIRON, issue 33)
+            let preview = match &s.biron {
+                Some(spec) => {
+                    biron::write_session(&s, spec, &text, &opts.profile, k, &path, bar.as_ref())?
+                }
+                None => {
+                    session::write_session(&s, &text, &opts.profile, &base, k, &path, bar.as_ref())?
+                }
+            };
             Ok((path, (k == 0).then_some(preview)))
         })
         .collect();

@@ -122,6 +122,32 @@ impl Body {
 
     /// Append the body's primitives.
     pub fn primitives(&self, s: &PersonState, out: &mut Vec<Primitive>) {
+        self.primitives_with_head(s, None, out);
+    }
+
+    /// Append the body's primitives with a painted face ([`super::face`]) on a head turned to
+    /// `head_yaw` (rad, in the world; the body keeps `s.heading`).
+    pub fn primitives_with_face(&self, s: &PersonState, head_yaw: f64, out: &mut Vec<Primitive>) {
+        self.primitives_with_head(s, Some((head_yaw, &super::face::DEFAULT_STYLE)), out);
+    }
+
+    /// As [`Self::primitives_with_face`] with the face drawn in `style`.
+    pub fn primitives_with_face_style(
+        &self,
+        s: &PersonState,
+        head_yaw: f64,
+        style: &'static super::face::FaceStyle,
+        out: &mut Vec<Primitive>,
+    ) {
+        self.primitives_with_head(s, Some((head_yaw, style)), out);
+    }
+
+    fn primitives_with_head(
+        &self,
+        s: &PersonState,
+        face: Option<(f64, &'static super::face::FaceStyle)>,
+        out: &mut Vec<Primitive>,
+    ) {
         let id = self.object();
         let h = self.height;
         let (sn, cs) = s.heading.sin_cos();
@@ -223,26 +249,27 @@ impl Body {
             .skin_below(f64::INFINITY),
         );
         let head = self.head_center(s);
-        let hairline = head.z + 0.035;
+        let hairline = head.z + super::face::HAIRLINE_U;
+        let texture = self.head_texture(head, hairline, face);
         out.push(
             Primitive::new(
                 Shape::Ellipsoid {
                     center: head,
                     radii: Vector3::new(0.1, 0.085, HEAD_HALF_HEIGHT),
-                    yaw: s.heading,
+                    yaw: face.map_or(s.heading, |f| f.0),
                 },
                 Material {
                     albedo: linear(self.skin),
-                    texture: Texture::Split {
-                        z: hairline as f32,
-                        above: linear(self.hair),
-                    },
+                    texture,
                     emissive: false,
                 },
                 id,
             )
             .skin_below(hairline),
         );
+        if let Some((yaw, _)) = face {
+            self.face_relief(head, yaw, id, out);
+        }
         if let Some(hat) = self.hat {
             out.push(Primitive::new(
                 Shape::Cylinder {
@@ -255,6 +282,49 @@ impl Body {
                 Material::flat(hat),
                 id,
             ));
+        }
+    }
+
+    /// The head's texture: hair above the hairline, or a painted face turned to its yaw.
+    fn head_texture(
+        &self,
+        head: Point3<f64>,
+        hairline: f64,
+        face: Option<(f64, &'static super::face::FaceStyle)>,
+    ) -> Texture {
+        match face {
+            None => Texture::Split {
+                z: hairline as f32,
+                above: linear(self.hair),
+            },
+            Some((yaw, style)) => Texture::Face {
+                center: [head.x as f32, head.y as f32, head.z as f32],
+                yaw: yaw as f32,
+                hair: linear(self.hair),
+                style,
+            },
+        }
+    }
+
+    /// A face's relief: the nose (in front of the head centre, 2.5 cm below it) and the ears
+    /// (at the sides), small skin ellipsoids that turn with the head's yaw.
+    fn face_relief(&self, head: Point3<f64>, yaw: f64, id: u32, out: &mut Vec<Primitive>) {
+        let (sn, cs) = yaw.sin_cos();
+        let at = |f: f64, s: f64, u: f64| head + Vector3::new(f * cs - s * sn, f * sn + s * cs, u);
+        let parts = [
+            (at(0.092, 0.0, -0.025), Vector3::new(0.022, 0.011, 0.028)),
+            (at(0.0, 0.084, -0.005), Vector3::new(0.012, 0.008, 0.03)),
+            (at(0.0, -0.084, -0.005), Vector3::new(0.012, 0.008, 0.03)),
+        ];
+        for (center, radii) in parts {
+            out.push(
+                Primitive::new(
+                    Shape::Ellipsoid { center, radii, yaw },
+                    Material::flat(self.skin),
+                    id,
+                )
+                .skin_below(f64::INFINITY),
+            );
         }
     }
 

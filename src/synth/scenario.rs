@@ -11,7 +11,9 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+mod biron;
 mod follow;
+pub use biron::BironSpec;
 use follow::follow_problem;
 pub use follow::{Controller, Estimator, Follow};
 
@@ -638,6 +640,8 @@ pub struct Scenario {
     #[serde(default)]
     pub sensors: Vec<SensorSpec>,
     pub calibration: Option<Calibration>,
+    /// Seed 003's BIRON home tour, written by `synth::biron` (issue 33).
+    pub biron: Option<BironSpec>,
 }
 
 impl Scenario {
@@ -776,6 +780,9 @@ impl Scenario {
                 }
             }
             RobotMode::Static => {}
+        }
+        if let Some((key, reason)) = self.biron.as_ref().and_then(BironSpec::problem) {
+            return bad(&format!("biron.{key}"), reason);
         }
         if let Some(c) = &self.calibration
             && !self.people.iter().any(|p| p.id == c.person)

@@ -38,6 +38,13 @@ pub enum Texture {
     Screen {
         phase: f32,
     },
+    /// A head with a face looking toward `yaw` ([`super::face`]); the albedo is the skin.
+    Face {
+        center: [f32; 3],
+        yaw: f32,
+        hair: [f32; 3],
+        style: &'static super::face::FaceStyle,
+    },
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -118,6 +125,19 @@ impl Material {
                     self.albedo
                 }
             }
+            Texture::Face {
+                center,
+                yaw,
+                hair,
+                style,
+            } => super::face::albedo(
+                [p.x, p.y, p.z],
+                center.map(f64::from),
+                f64::from(yaw),
+                self.albedo,
+                hair,
+                style,
+            ),
             Texture::Screen { phase } => {
                 let v = uv.map_or(0.0, |(_, v)| v) as f32;
                 let bars = 0.5 + 0.5 * (std::f32::consts::TAU * (v * 1.5 + phase)).sin();

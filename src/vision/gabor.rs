@@ -512,8 +512,8 @@ impl GaborBackground {
         }
         let mut median = RgbImage::new(w, h);
         let k = frames.len();
-        median
-            .as_mut()
+        let pixels: &mut [u8] = &mut median;
+        pixels
             .par_chunks_mut(3 * w as usize)
             .enumerate()
             .for_each(|(y, row)| {

@@ -41,6 +41,7 @@ pub mod colortrack;
 pub mod cylinder;
 pub mod egomotion;
 pub mod ellipse;
+pub mod faces;
 pub mod gabor;
 pub mod gmm;
 pub mod jabri;

@@ -1,0 +1,320 @@
+//! GCC-PHAT: the generalised cross-correlation of two microphone signals with the phase
+//! transform (Knapp & Carter 1976, "The generalized correlation method for estimation of time
+//! delay", the PHAT weighting 1/|G|), the time-delay estimator of two-microphone speaker
+//! localisation (BIRON, seed 003; Lang et al. 2003 do not print their estimator).
+//!
+//! A block of the two channels is cut into Hann-windowed frames; their cross-spectra
+//! `G(ω) = X₁(ω)·X₀*(ω)` are summed over the block, each bin of the sum is divided by its
+//! magnitude (PHAT), bins outside `[band_lo, band_hi]` are set to zero, and the inverse FFT —
+//! zero-padded by `interp` for a finer lag grid — is the correlation `r(τ)`. With this sign
+//! convention a signal that reaches microphone 1 `τ` seconds after microphone 0 peaks at
+//! `+τ`. The peak is searched within the physically possible lags `±d/c` and refined by a
+//! parabola through the peak and its two neighbours ([`Refine::Parabolic`]), or left on the
+//! grid ([`Refine::Grid`], for the quantisation bound). The peak height divided by the number
+//! of kept bins is 1 for a pure delay and near 0 for incoherent noise.
+//!
+//! With [`GccParams::loud_half`] only the louder half of the block's frames (by the energy of
+//! microphone 0) enters the sum: the syllables, not the pauses between them, where only the
+//! room's noise and reverberation tail are left. Chosen on the quick profile's first session
+//! (nominal condition, 0.5 s single-talker blocks: median error 7.7° against 9.5° with all
+//! frames; anechoic 30 dB: 0.43° against 0.35°).
+//!
+//! FFTs by `realfft`/`rustfft`. Not here: frame-wise tracking, several sources per block.
+
+use std::sync::Arc;
+
+use realfft::num_complex::Complex;
+use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum GccError {
+    #[error("GCC-PHAT settings: {0}")]
+    Settings(String),
+    #[error("GCC-PHAT: channels differ in length ({left} vs {right} samples)")]
+    Lengths { left: usize, right: usize },
+    #[error("GCC-PHAT: a block of {samples} samples is shorter than one frame ({frame})")]
+    Short { samples: usize, frame: usize },
+    #[error("GCC-PHAT: FFT failed: {0}")]
+    Fft(String),
+}
+
+/// How the peak lag is read off the correlation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Refine {
+    /// The lag of the largest grid value (grid step `1 / (fs · interp)`).
+    Grid,
+    /// A parabola through the largest grid value and its neighbours.
+    Parabolic,
+}
+
+/// GCC-PHAT settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GccParams {
+    /// Sample rate (Hz).
+    pub sample_rate: f64,
+    /// Frame length (samples, a power of two).
+    pub frame: usize,
+    /// Hop between frames (samples).
+    pub hop: usize,
+    /// Zero-padding factor of the inverse FFT (lag grid step `1 / (fs · interp)`).
+    pub interp: usize,
+    /// Frequency band kept (Hz).
+    pub band_lo: f64,
+    pub band_hi: f64,
+    pub refine: Refine,
+    /// Sum only the louder half of the frames (see the module doc).
+    pub loud_half: bool,
+}
+
+impl Default for GccParams {
+    /// 16 kHz; 1024-sample frames (64 ms, the chunk length of the logged audio) with half
+    /// overlap; lags on a 1/16-sample grid refined by a parabola; the band 200–6000 Hz where
+    /// voiced speech carries its energy. Chosen a priori (Knapp & Carter give no numbers; the
+    /// seed none).
+    fn default() -> Self {
+        GccParams {
+            sample_rate: 16_000.0,
+            frame: 1024,
+            hop: 512,
+            interp: 16,
+            band_lo: 200.0,
+            band_hi: 6000.0,
+            refine: Refine::Parabolic,
+            loud_half: true,
+        }
+    }
+}
+
+/// The result of one block.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Delay {
+    /// Arrival at microphone 1 minus arrival at microphone 0 (s).
+    pub tau_s: f64,
+    /// PHAT peak height: 1 for a pure delay, near 0 for incoherent noise.
+    pub peak: f64,
+    /// Frames summed.
+    pub frames: usize,
+}
+
+/// A GCC-PHAT estimator with its FFT plans and buffers.
+pub struct GccPhat {
+    pub params: GccParams,
+    window: Vec<f64>,
+    r2c: Arc<dyn RealToComplex<f64>>,
+    c2r: Arc<dyn ComplexToReal<f64>>,
+    frame_in: Vec<f64>,
+    spec0: Vec<Complex<f64>>,
+    spec1: Vec<Complex<f64>>,
+    padded: Vec<Complex<f64>>,
+    corr: Vec<f64>,
+}
+
+impl GccPhat {
+    pub fn new(params: GccParams) -> Result<GccPhat, GccError> {
+        let p = &params;
+        if !p.frame.is_power_of_two() || p.frame < 16 {
+            return Err(GccError::Settings(format!(
+                "frame {} is not a power of two >= 16",
+                p.frame
+            )));
+        }
+        if p.hop == 0 || p.hop > p.frame {
+            return Err(GccError::Settings(format!(
+                "hop {} not in [1, frame]",
+                p.hop
+            )));
+        }
+        if p.interp == 0 || p.interp > 64 {
+            return Err(GccError::Settings(format!(
+                "interp {} not in [1, 64]",
+                p.interp
+            )));
+        }
+        if !(p.sample_rate > 0.0 && p.band_lo >= 0.0 && p.band_lo < p.band_hi) {
+            return Err(GccError::Settings(
+                "needs a positive sample rate and band_lo < band_hi".into(),
+            ));
+        }
+        let mut planner = RealFftPlanner::<f64>::new();
+        let r2c = planner.plan_fft_forward(p.frame);
+        let c2r = planner.plan_fft_inverse(p.frame * p.interp);
+        let n = p.frame;
+        let window = (0..n)
+            .map(|i| 0.5 - 0.5 * (std::f64::consts::TAU * i as f64 / n as f64).cos())
+            .collect();
+        Ok(GccPhat {
+            window,
+            frame_in: vec![0.0; n],
+            spec0: r2c.make_output_vec(),
+            spec1: r2c.make_output_vec(),
+            padded: c2r.make_input_vec(),
+            corr: c2r.make_output_vec(),
+            r2c,
+            c2r,
+            params,
+        })
+    }
+
+    /// Largest lag (s) two microphones `spacing_m` apart can show.
+    pub fn max_lag_s(spacing_m: f64) -> f64 {
+        spacing_m / super::SPEED_OF_SOUND_M_S
+    }
+
+    /// The PHAT-weighted cross-spectrum of a block (`x0`, `x1`: microphones 0 and 1), one
+    /// value per bin `0..=frame/2`, and the number of frames summed.
+    pub fn cross_spectrum(
+        &mut self,
+        x0: &[f32],
+        x1: &[f32],
+    ) -> Result<(Vec<Complex<f64>>, usize), GccError> {
+        if x0.len() != x1.len() {
+            return Err(GccError::Lengths {
+                left: x0.len(),
+                right: x1.len(),
+            });
+        }
+        let n = self.params.frame;
+        if x0.len() < n {
+            return Err(GccError::Short {
+                samples: x0.len(),
+                frame: n,
+            });
+        }
+        let starts: Vec<usize> = (0..)
+            .map(|k| k * self.params.hop)
+            .take_while(|s| s + n <= x0.len())
+            .collect();
+        let energy = |s: usize| {
+            x0[s..s + n]
+                .iter()
+                .map(|v| f64::from(*v).powi(2))
+                .sum::<f64>()
+        };
+        let keep: Vec<usize> = if self.params.loud_half && starts.len() > 1 {
+            let mut by: Vec<(f64, usize)> = starts.iter().map(|&s| (energy(s), s)).collect();
+            by.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            let mut k: Vec<usize> = by[..starts.len().div_ceil(2)].iter().map(|x| x.1).collect();
+            k.sort_unstable();
+            k
+        } else {
+            starts
+        };
+        let mut sum = vec![Complex::new(0.0, 0.0); n / 2 + 1];
+        for &start in &keep {
+            self.fft_frame(&x0[start..start + n], true)?;
+            self.fft_frame(&x1[start..start + n], false)?;
+            for (s, (a, b)) in sum.iter_mut().zip(self.spec0.iter().zip(&self.spec1)) {
+                *s += b * a.conj();
+            }
+        }
+        let frames = keep.len();
+        let bin_hz = self.params.sample_rate / n as f64;
+        for (k, s) in sum.iter_mut().enumerate() {
+            let f = k as f64 * bin_hz;
+            let m = s.norm();
+            *s = if f < self.params.band_lo || f > self.params.band_hi || m <= 1e-300 {
+                Complex::new(0.0, 0.0)
+            } else {
+                *s / m
+            };
+        }
+        Ok((sum, frames))
+    }
+
+    fn fft_frame(&mut self, x: &[f32], first: bool) -> Result<(), GccError> {
+        for ((d, &s), w) in self.frame_in.iter_mut().zip(x).zip(&self.window) {
+            *d = f64::from(s) * w;
+        }
+        let out = if first {
+            &mut self.spec0
+        } else {
+            &mut self.spec1
+        };
+        self.r2c
+            .process(&mut self.frame_in, out)
+            .map_err(|e| GccError::Fft(e.to_string()))
+    }
+
+    /// The correlation of a PHAT cross-spectrum on the lag grid within `±max_lag_s`: the
+    /// first lag (s), the grid step (s) and the values (divided by the number of kept bins,
+    /// so a pure delay peaks at 1).
+    pub fn correlation(
+        &mut self,
+        cross: &[Complex<f64>],
+        max_lag_s: f64,
+    ) -> Result<(f64, f64, Vec<f64>), GccError> {
+        let n = self.params.frame;
+        let big = n * self.params.interp;
+        self.padded
+            .iter_mut()
+            .for_each(|c| *c = Complex::new(0.0, 0.0));
+        for (d, s) in self.padded.iter_mut().zip(cross) {
+            *d = *s;
+        }
+        // the inverse real FFT needs real DC and Nyquist bins
+        self.padded[0].im = 0.0;
+        let last = self.padded.len() - 1;
+        self.padded[last].im = 0.0;
+        self.c2r
+            .process(&mut self.padded, &mut self.corr)
+            .map_err(|e| GccError::Fft(e.to_string()))?;
+        // a pure delay sums to 2 per kept bin (its mirror included), 1 at DC and Nyquist
+        let kept: f64 = cross
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.norm() > 0.0)
+            .map(|(k, _)| if k == 0 || k == n / 2 { 1.0 } else { 2.0 })
+            .sum();
+        let scale = kept.max(1.0);
+        let step = 1.0 / (self.params.sample_rate * self.params.interp as f64);
+        let max_k = ((max_lag_s / step).ceil() as usize).min(big / 2 - 1);
+        let values: Vec<f64> = (0..=2 * max_k)
+            .map(|i| {
+                let k = i as isize - max_k as isize;
+                self.corr[k.rem_euclid(big as isize) as usize] / scale
+            })
+            .collect();
+        Ok((-(max_k as f64) * step, step, values))
+    }
+
+    /// The delay of a block within `±max_lag_s` (see the module doc).
+    pub fn delay(&mut self, x0: &[f32], x1: &[f32], max_lag_s: f64) -> Result<Delay, GccError> {
+        let (cross, frames) = self.cross_spectrum(x0, x1)?;
+        let (first, step, r) = self.correlation(&cross, max_lag_s)?;
+        let (tau_s, peak) = peak(&r, first, step, max_lag_s, self.params.refine);
+        Ok(Delay {
+            tau_s,
+            peak,
+            frames,
+        })
+    }
+}
+
+/// The largest value of `r` (grid from `first`, step `step`) within `±max_lag`, and its lag.
+pub fn peak(r: &[f64], first: f64, step: f64, max_lag: f64, refine: Refine) -> (f64, f64) {
+    let lag = |i: usize| first + i as f64 * step;
+    let mut best: Option<usize> = None;
+    for (i, v) in r.iter().enumerate() {
+        if lag(i).abs() <= max_lag + 1e-12 && best.is_none_or(|b| *v > r[b]) {
+            best = Some(i);
+        }
+    }
+    let Some(b) = best else {
+        return (0.0, 0.0);
+    };
+    if refine == Refine::Grid || b == 0 || b + 1 >= r.len() {
+        return (lag(b), r[b]);
+    }
+    let (ym, y0, yp) = (r[b - 1], r[b], r[b + 1]);
+    let den = ym - 2.0 * y0 + yp;
+    if den >= 0.0 {
+        return (lag(b), y0);
+    }
+    let delta = (0.5 * (ym - yp) / den).clamp(-0.5, 0.5);
+    let tau = (lag(b) + delta * step).clamp(-max_lag, max_lag);
+    (tau, y0 - 0.25 * (ym - yp) * delta)
+}
+
+#[cfg(test)]
+#[path = "gcc_tests.rs"]
+mod tests;

@@ -1,0 +1,138 @@
+use realfft::RealFftPlanner;
+
+use super::*;
+use crate::audio::doa::{self, BIRON_SPACING_M};
+use crate::rng;
+
+const FS: f64 = 16_000.0;
+
+/// White noise of `n` samples (a power of two) and the same noise delayed by `delay`
+/// samples (circularly, by a phase ramp: an exact fractional delay), as microphones 0 and 1.
+fn delayed_noise(n: usize, delay: f64, seed: u64) -> (Vec<f32>, Vec<f32>) {
+    let x: Vec<f64> = (0..n)
+        .map(|i| f64::from(rng::gauss(rng::hash(seed, &[i as u64]))))
+        .collect();
+    let mut planner = RealFftPlanner::<f64>::new();
+    let fwd = planner.plan_fft_forward(n);
+    let inv = planner.plan_fft_inverse(n);
+    let mut input = x.clone();
+    let mut spec = fwd.make_output_vec();
+    fwd.process(&mut input, &mut spec).expect("fft");
+    for (k, c) in spec.iter_mut().enumerate() {
+        let ph = -std::f64::consts::TAU * k as f64 * delay / n as f64;
+        *c *= Complex::new(ph.cos(), ph.sin());
+    }
+    spec[0].im = 0.0;
+    let last = spec.len() - 1;
+    spec[last] = Complex::new(0.0, 0.0);
+    let mut y = inv.make_output_vec();
+    inv.process(&mut spec, &mut y).expect("ifft");
+    let x0 = x.iter().map(|&v| v as f32).collect();
+    let x1 = y.iter().map(|&v| (v / n as f64) as f32).collect();
+    (x0, x1)
+}
+
+fn block(x: &[f32]) -> &[f32] {
+    &x[4096..4096 + 8000] // 0.5 s away from the circular wrap
+}
+
+#[test]
+fn pure_fractional_delays_give_the_angle_within_a_tenth_of_a_degree() {
+    let mut g = GccPhat::new(GccParams::default()).expect("gcc");
+    let max = GccPhat::max_lag_s(BIRON_SPACING_M);
+    for (k, deg) in [-75.0f64, -40.0, -12.3, 0.0, 7.7, 33.0, 61.0, 80.0]
+        .into_iter()
+        .enumerate()
+    {
+        let tau = doa::delay_of(deg.to_radians(), 0.0, BIRON_SPACING_M);
+        let (x0, x1) = delayed_noise(16_384, tau * FS, 11 + k as u64);
+        let d = g.delay(block(&x0), block(&x1), max).expect("delay");
+        let got = doa::cone_angle(d.tau_s, BIRON_SPACING_M).to_degrees();
+        assert!((got - deg).abs() < 0.1, "{deg}°: got {got}°");
+        assert!(d.peak > 0.9, "{deg}°: peak {}", d.peak);
+        assert_eq!(d.frames, 7, "the louder half of 14 frames");
+    }
+}
+
+#[test]
+fn a_signal_that_reaches_microphone_1_later_gives_a_positive_delay() {
+    let mut g = GccPhat::new(GccParams::default()).expect("gcc");
+    let (x0, x1) = delayed_noise(16_384, 3.25, 5);
+    let d = g.delay(block(&x0), block(&x1), 1e-3).expect("delay");
+    assert!((d.tau_s * FS - 3.25).abs() < 0.02, "{}", d.tau_s * FS);
+    // swapped channels: the opposite sign
+    let d = g.delay(block(&x1), block(&x0), 1e-3).expect("delay");
+    assert!((d.tau_s * FS + 3.25).abs() < 0.02, "{}", d.tau_s * FS);
+}
+
+#[test]
+fn a_source_behind_the_robot_is_read_as_its_mirror_in_front() {
+    let mut g = GccPhat::new(GccParams::default()).expect("gcc");
+    let behind = 140f64.to_radians(); // left and behind
+    let tau = doa::delay_of(behind, 0.0, BIRON_SPACING_M);
+    let (x0, x1) = delayed_noise(16_384, tau * FS, 9);
+    let d = g
+        .delay(block(&x0), block(&x1), GccPhat::max_lag_s(BIRON_SPACING_M))
+        .expect("delay");
+    let front = doa::azimuth(doa::cone_angle(d.tau_s, BIRON_SPACING_M), 0.0);
+    assert!(
+        (front.to_degrees() - 40.0).abs() < 0.1,
+        "{}",
+        front.to_degrees()
+    );
+    assert!((doa::mirror(front) - behind).abs() < 0.1f64.to_radians());
+}
+
+#[test]
+fn integer_lags_alone_err_by_up_to_the_quantisation_bound_and_no_more() {
+    let params = GccParams {
+        interp: 1,
+        refine: Refine::Grid,
+        loud_half: false,
+        ..GccParams::default()
+    };
+    let mut g = GccPhat::new(params).expect("gcc");
+    let max = GccPhat::max_lag_s(BIRON_SPACING_M);
+    let mut worst_ratio: f64 = 0.0;
+    for k in 0..40 {
+        let deg = -60.0 + 3.0 * f64::from(k) + 0.37;
+        let cone = f64::to_radians(deg);
+        let tau = doa::delay_of(cone, 0.0, BIRON_SPACING_M);
+        let (x0, x1) = delayed_noise(16_384, tau * FS, 100 + k as u64);
+        let d = g.delay(block(&x0), block(&x1), max).expect("delay");
+        let err = (doa::cone_angle(d.tau_s, BIRON_SPACING_M) - cone).abs();
+        let bound = doa::quantisation_bound(cone, 1.0 / FS, BIRON_SPACING_M);
+        assert!(err <= bound + 1e-9, "{deg}°: {err} > bound {bound}");
+        worst_ratio = worst_ratio.max(err / bound);
+    }
+    assert!(worst_ratio > 0.8, "the bound is reached: {worst_ratio}");
+}
+
+#[test]
+fn independent_noise_on_the_two_microphones_gives_a_low_peak() {
+    let mut g = GccPhat::new(GccParams::default()).expect("gcc");
+    let x0: Vec<f32> = (0..8000).map(|i| rng::gauss(rng::hash(1, &[i]))).collect();
+    let x1: Vec<f32> = (0..8000).map(|i| rng::gauss(rng::hash(2, &[i]))).collect();
+    let d = g
+        .delay(&x0, &x1, GccPhat::max_lag_s(BIRON_SPACING_M))
+        .expect("delay");
+    assert!(d.peak < 0.35, "{}", d.peak);
+}
+
+#[test]
+fn bad_blocks_and_settings_are_errors() {
+    let mut g = GccPhat::new(GccParams::default()).expect("gcc");
+    assert!(matches!(
+        g.delay(&[0.0; 2000], &[0.0; 1999], 1e-3),
+        Err(GccError::Lengths { .. })
+    ));
+    assert!(matches!(
+        g.delay(&[0.0; 100], &[0.0; 100], 1e-3),
+        Err(GccError::Short { .. })
+    ));
+    let bad = GccParams {
+        frame: 1000,
+        ..GccParams::default()
+    };
+    assert!(GccPhat::new(bad).is_err());
+}

@@ -1,0 +1,174 @@
+//! Frontal face detection, seed 003 (BIRON, Wrede et al. 2004, §IV-A: "the face detection
+//! works for faces in frontal view only"; Lang et al. 2003). BIRON's own detector is not
+//! published as code; this module wraps the `rustface` crate (a Rust port of the SeetaFace
+//! funnel-structured cascade, Wu et al., BSD-2-Clause) with its frontal model
+//! `seeta_fd_frontal_v1.0.bin`, vendored in `assets/models/` with its licence (the crate
+//! ships the file in its package but does not expose it) and compiled into the binary.
+//!
+//! [`FaceDetector::detect`] takes a grey image and returns face boxes with their scores;
+//! [`grey_from_rgb`] converts an RGB frame (ITU-R BT.601 luma, rounded). The detector runs
+//! single-threaded (the crate's `rayon` feature is off) so results do not depend on the
+//! thread count. Bad input (an empty image, a buffer of the wrong size) is an error, never
+//! the crate's panic.
+//!
+//! It does not estimate head pose, track faces, or recognise who a face belongs to.
+
+use crate::vision::view::{ImageView, ViewError};
+
+/// The SeetaFace frontal model (1.2 MB), from the `rustface` 0.1.7 package.
+static MODEL: &[u8] = include_bytes!("../../assets/models/seeta_fd_frontal_v1.0.bin");
+
+/// Smallest face window the SeetaFace cascade accepts (px); `rustface` panics below it.
+pub const MIN_WINDOW_PX: u32 = 20;
+
+/// Detector settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FaceParams {
+    /// Smallest face searched for (px, at least [`MIN_WINDOW_PX`]).
+    pub min_face_px: u32,
+    /// Score threshold of the cascade's last stage.
+    pub score_thresh: f64,
+    /// Scale step between pyramid levels, in (0.1, 0.99).
+    pub pyramid_scale: f32,
+    /// Sliding window step (px).
+    pub step_px: u32,
+}
+
+impl Default for FaceParams {
+    /// `rustface`'s own example settings (min face 20 px, threshold 2.0, pyramid 0.8, step 4),
+    /// chosen a priori: the SeetaFace README lists 0.95, 2.8 and 4.5 as typical thresholds.
+    fn default() -> Self {
+        FaceParams {
+            min_face_px: MIN_WINDOW_PX,
+            score_thresh: 2.0,
+            pyramid_scale: 0.8,
+            step_px: 4,
+        }
+    }
+}
+
+/// A detected face: its box (px, top-left corner and size) and the cascade's score.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Face {
+    pub x: f64,
+    pub y: f64,
+    pub width: f64,
+    pub height: f64,
+    pub score: f64,
+}
+
+impl Face {
+    pub fn center(&self) -> [f64; 2] {
+        [self.x + self.width / 2.0, self.y + self.height / 2.0]
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FaceError {
+    #[error("face detection: {0}")]
+    View(#[from] ViewError),
+    #[error("face detection needs a grey image, got {channels} channels")]
+    Channels { channels: usize },
+    #[error("face detection: the image is {width}x{height}, larger than 32767 px a side")]
+    TooLarge { width: usize, height: usize },
+    #[error("face settings: {0}")]
+    Params(String),
+    #[error("face model: {0}")]
+    Model(String),
+}
+
+/// The SeetaFace frontal detector with its settings.
+pub struct FaceDetector {
+    inner: Box<dyn rustface::Detector>,
+    pub params: FaceParams,
+}
+
+impl FaceDetector {
+    /// The detector with the vendored model and `params` (checked: the crate panics on
+    /// out-of-range settings).
+    pub fn new(params: FaceParams) -> Result<FaceDetector, FaceError> {
+        if params.min_face_px < MIN_WINDOW_PX {
+            return Err(FaceError::Params(format!(
+                "min_face_px {} is below the cascade's {MIN_WINDOW_PX} px window",
+                params.min_face_px
+            )));
+        }
+        if !(params.score_thresh > 0.0 && params.score_thresh.is_finite()) {
+            return Err(FaceError::Params(format!(
+                "score_thresh {} must be positive",
+                params.score_thresh
+            )));
+        }
+        if !(params.pyramid_scale > 0.1 && params.pyramid_scale < 0.99) {
+            return Err(FaceError::Params(format!(
+                "pyramid_scale {} is not in (0.1, 0.99)",
+                params.pyramid_scale
+            )));
+        }
+        if params.step_px == 0 {
+            return Err(FaceError::Params("step_px must be at least 1".into()));
+        }
+        let model = rustface::read_model(std::io::Cursor::new(MODEL))
+            .map_err(|e| FaceError::Model(e.to_string()))?;
+        let mut inner = rustface::create_detector_with_model(model);
+        inner.set_min_face_size(params.min_face_px);
+        inner.set_score_thresh(params.score_thresh);
+        inner.set_pyramid_scale_factor(params.pyramid_scale);
+        inner.set_slide_window_step(params.step_px, params.step_px);
+        Ok(FaceDetector { inner, params })
+    }
+
+    /// Faces in a grey image, in the detector's order (by score after its non-maximum
+    /// suppression). An image smaller than the smallest face gives none.
+    pub fn detect(&mut self, grey: ImageView) -> Result<Vec<Face>, FaceError> {
+        if grey.channels() != 1 {
+            return Err(FaceError::Channels {
+                channels: grey.channels(),
+            });
+        }
+        let (w, h) = (grey.width(), grey.height());
+        if w > 32767 || h > 32767 {
+            return Err(FaceError::TooLarge {
+                width: w,
+                height: h,
+            });
+        }
+        let least = self.params.min_face_px as usize;
+        if w < least || h < least {
+            return Ok(Vec::new());
+        }
+        let image = rustface::ImageData::new(grey.data(), w as u32, h as u32);
+        Ok(self
+            .inner
+            .detect(&image)
+            .iter()
+            .map(|f| {
+                let b = f.bbox();
+                Face {
+                    x: f64::from(b.x()),
+                    y: f64::from(b.y()),
+                    width: f64::from(b.width()),
+                    height: f64::from(b.height()),
+                    score: f.score(),
+                }
+            })
+            .collect())
+    }
+}
+
+/// ITU-R BT.601 luma of an RGB image, rounded: `(299 R + 587 G + 114 B + 500) / 1000`.
+pub fn grey_from_rgb(rgb: ImageView) -> Result<Vec<u8>, FaceError> {
+    if rgb.channels() != 3 {
+        return Err(FaceError::Channels {
+            channels: rgb.channels(),
+        });
+    }
+    Ok(rgb
+        .data()
+        .chunks_exact(3)
+        .map(|p| {
+            let y = 299 * u32::from(p[0]) + 587 * u32::from(p[1]) + 114 * u32::from(p[2]);
+            ((y + 500) / 1000) as u8
+        })
+        .collect())
+}
