@@ -183,6 +183,24 @@ impl Default for Params {
     }
 }
 
+/// The checks of `occupancy`, `detector_noise` and `noise_associations` (issue 32).
+fn validate_noise(p: &Params, bad: &mut impl FnMut(&str, String)) {
+    if let Err(e) = p.occupancy.validate() {
+        bad("occupancy", e.to_string());
+    }
+    for (k, n) in p.detector_noise.iter().enumerate() {
+        if let Err(e) = n.validate() {
+            bad("detector_noise", format!("level {}: {e}", k + 1));
+        }
+    }
+    if !p.detector_noise.is_empty() && p.noise_associations.is_empty() {
+        bad(
+            "noise_associations",
+            "needs at least one association to run the noise levels with".into(),
+        );
+    }
+}
+
 /// Parameter checks beyond types: `(key, reason)` for each problem.
 pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
     let mut out: Vec<Invalid> = Vec::new();
@@ -299,20 +317,7 @@ pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
             format!("{} is not a finite distance ≥ 0 m", p.ground_separation_m),
         );
     }
-    if let Err(e) = p.occupancy.validate() {
-        bad("occupancy", e.to_string());
-    }
-    for (k, n) in p.detector_noise.iter().enumerate() {
-        if let Err(e) = n.validate() {
-            bad("detector_noise", format!("level {}: {e}", k + 1));
-        }
-    }
-    if !p.detector_noise.is_empty() && p.noise_associations.is_empty() {
-        bad(
-            "noise_associations",
-            "needs at least one association to run the noise levels with".into(),
-        );
-    }
+    validate_noise(p, &mut bad);
     if p.n_app_sweep.contains(&0) {
         bad("n_app_sweep", "values must be at least 1".into());
     }
