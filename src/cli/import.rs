@@ -1,8 +1,10 @@
-//! `peopletrack import wildtrack DIR -o FILE.mcap`: a public dataset as a session log
+//! `peopletrack import wildtrack DIR -o FILE.mcap [--detector-noise drop=…,jitter=…,false=…]`:
+//! a public dataset as a session log, optionally through the detector model
 //! ([`peopletrack::log::import`]).
 
 use std::path::PathBuf;
 
+use peopletrack::log::import::detector_noise::DetectorNoise;
 use peopletrack::log::import::wildtrack::{self, Intrinsics};
 
 #[derive(Debug, clap::Args)]
@@ -25,6 +27,15 @@ pub enum Dataset {
         /// undistorted images the boxes were annotated on).
         #[arg(long)]
         original_intrinsics: bool,
+        /// Pass the annotated boxes through the detector model of our own before writing them
+        /// (`drop=0.2,jitter=0.04,false=1`: miss probability, edge noise as a fraction of the
+        /// box height, mean false person-shaped boxes per camera frame; the ground truth stays
+        /// the annotation).
+        #[arg(long, value_name = "drop=P,jitter=F,false=N")]
+        detector_noise: Option<String>,
+        /// Seed of the detector model's draws.
+        #[arg(long, default_value_t = 1)]
+        noise_seed: u64,
     },
 }
 
@@ -34,7 +45,14 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
             dir,
             out: file,
             original_intrinsics,
+            detector_noise,
+            noise_seed,
         } => {
+            let noise = detector_noise
+                .as_deref()
+                .map(DetectorNoise::parse)
+                .transpose()
+                .map_err(|e| anyhow::anyhow!("--detector-noise: {e}"))?;
             let intr = if *original_intrinsics {
                 Intrinsics::Original
             } else {
@@ -65,7 +83,13 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
                     ds.first_skip.as_deref().unwrap_or("")
                 )?;
             }
-            let s = wildtrack::write(&ds, dir, intr, file)?;
+            let s = wildtrack::write_noisy(
+                &ds,
+                dir,
+                intr,
+                noise.as_ref().map(|n| (n, *noise_seed)),
+                file,
+            )?;
             writeln!(
                 out,
                 "{}: {} frames, {} person-frames, {} boxes in 7 cameras ({}; {} views not visible)",
@@ -76,6 +100,13 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
                 intr.folder(),
                 ds.invisible_views
             )?;
+            if let Some(n) = &noise {
+                writeln!(
+                    out,
+                    "detections through the detector model ({}; seed {noise_seed})",
+                    n.label()
+                )?;
+            }
             Ok(())
         }
     }

@@ -4,9 +4,12 @@
 //! any other log. Each importer is a pure reading of the dataset's files into typed parts plus
 //! one writing step through [`super::SessionWriter`] (atomic: scratch file + rename).
 //!
+//! - [`detector_noise`]: a detector model of our own (drops, edge jitter, false person-shaped
+//!   boxes; seeded) applied to exact boxes before they are written or tracked.
 //! - [`wildtrack`]: WILDTRACK (Chavdarova et al. 2018): 7 calibrated HD cameras, annotated
 //!   boxes and ground positions.
 
+pub mod detector_noise;
 pub mod wildtrack;
 
 /// Why an import failed; every variant names the file.

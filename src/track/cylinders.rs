@@ -41,7 +41,10 @@
 //! `Scalable` ([`scalable`]) builds new objects from pairwise-coherent head rays grown camera
 //! by camera and from box bottoms on the ground (single-camera people), with the same greedy
 //! selection by `E_c`; `Ground` ([`ground`]) associates every frame on the ground plane from
-//! box feet and heads and tracks the people found by assignment on the ground.
+//! box feet and heads and tracks the people found by assignment on the ground; `Occupancy`
+//! ([`occupancy`]) is the ground association for a noisy detector: box uncertainty in the fit,
+//! each person's per-frame log-odds from the cameras that see its ground point, and tracks
+//! reported once their accumulated log-odds confirm them.
 //!
 //! What it does not do: no appearance, no re-identification of discarded objects, no
 //! occlusion reasoning beyond what the combinations express.
@@ -57,9 +60,11 @@ mod candidate;
 use candidate::select_disjoint;
 mod ground;
 mod head;
+mod occupancy;
 mod scalable;
 
 pub use head::{box_head_px, cylinder_radius};
+pub use occupancy::OccupancyParams;
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CylinderError {
@@ -97,6 +102,9 @@ pub enum Association {
     Scalable,
     /// Per frame on the ground plane (feet and heads), then tracks by assignment ([`ground`]).
     Ground,
+    /// `Ground` for a noisy detector: box uncertainty, per-camera evidence, track scores
+    /// ([`occupancy`]).
+    Occupancy,
 }
 
 /// Which error chooses between valid combinations.
@@ -144,6 +152,8 @@ pub struct CylinderParams {
     pub radius_sigma_m: f64,
     /// Random-walk rate of height and radius (m/√s).
     pub size_walk_m: f64,
+    /// `Occupancy`: the detector's model and the track scores (unused by the others).
+    pub occupancy: OccupancyParams,
 }
 
 impl Default for CylinderParams {
@@ -167,6 +177,7 @@ impl Default for CylinderParams {
             height_sigma_m: 0.05,
             radius_sigma_m: 0.05,
             size_walk_m: 0.05,
+            occupancy: OccupancyParams::default(),
         }
     }
 }
@@ -194,6 +205,9 @@ impl CylinderParams {
         {
             return bad("head_height_m", "the range is empty".into());
         }
+        if self.association == Association::Occupancy {
+            self.occupancy.validate()?;
+        }
         Ok(())
     }
 }
@@ -212,6 +226,10 @@ struct Prepared {
     ground: Option<Point3<f64>>,
     /// The box bottom in ideal pixels.
     foot_ideal: Option<Point2<f64>>,
+    /// Multipliers of the foot and head residuals `(x, y)` (ideal px → px at the box's gate
+    /// `p_Th`): 1 except under `Occupancy` (box uncertainty).
+    w_foot: [f64; 2],
+    w_head: [f64; 2],
 }
 
 /// A valid combination: its support, triangulated head and errors.
@@ -299,6 +317,8 @@ pub struct CylinderTracker {
     objects: Vec<Object3d>,
     candidates: Vec<Candidate>,
     next_id: u32,
+    /// `Occupancy`: its tracks and each camera's view of the room.
+    occupancy: occupancy::State,
 }
 
 /// Number of cameras where two supports differ (absent on one side counts).
@@ -317,12 +337,18 @@ impl CylinderTracker {
         if views.len() < 2 {
             return Err(CylinderError::TooFewCameras(views.len()));
         }
+        let occupancy = if params.association == Association::Occupancy {
+            occupancy::State::new(&views, &params)
+        } else {
+            occupancy::State::default()
+        };
         Ok(CylinderTracker {
             views,
             params,
             objects: Vec::new(),
             candidates: Vec::new(),
             next_id: 1,
+            occupancy,
         })
     }
 
@@ -348,6 +374,7 @@ impl CylinderTracker {
                     let t = -fo.z / fd.z;
                     (t.is_finite() && t > 0.0).then(|| fo + fd * t)
                 });
+                let (w_foot, w_head) = self.residual_weights(o);
                 Some(Prepared {
                     camera: o.camera,
                     id: o.id,
@@ -360,6 +387,8 @@ impl CylinderTracker {
                     foot_ideal: o
                         .foot_px
                         .and_then(|f| view.ideal_px(&Point2::new(f[0], f[1]))),
+                    w_foot,
+                    w_head,
                 })
             })
             .collect();
@@ -458,6 +487,11 @@ impl CylinderTracker {
     }
 
     fn measure(&self, kf: &mut Kalman<6>, h: &Hypothesis) {
+        self.measure_sigma(kf, h, self.params.position_sigma_m);
+    }
+
+    /// [`Self::measure`] with this ground-position noise (m).
+    fn measure_sigma(&self, kf: &mut Kalman<6>, h: &Hypothesis, position_sigma_m: f64) {
         let p = &self.params;
         let mut hm = Matrix4x6::zeros();
         hm[(0, 0)] = 1.0;
@@ -465,8 +499,8 @@ impl CylinderTracker {
         hm[(2, 4)] = 1.0;
         hm[(3, 5)] = 1.0;
         let r = SMatrix::<f64, 4, 4>::from_diagonal(&Vector4::new(
-            p.position_sigma_m.powi(2),
-            p.position_sigma_m.powi(2),
+            position_sigma_m.powi(2),
+            position_sigma_m.powi(2),
             p.height_sigma_m.powi(2),
             p.radius_sigma_m.powi(2),
         ));
@@ -567,8 +601,10 @@ impl CylinderTracker {
     /// Advance one frame with this frame's 2-D objects; returns every 3-D object alive after
     /// it (supported or coasting), sorted by id.
     pub fn step(&mut self, objects: &[Object2d]) -> (Vec<Cylinder>, StepStats) {
-        if self.params.association == Association::Ground {
-            return self.step_ground(objects);
+        match self.params.association {
+            Association::Ground => return self.step_ground(objects),
+            Association::Occupancy => return self.step_occupancy(objects),
+            Association::Paper | Association::Scalable => {}
         }
         let mut stats = StepStats::default();
         let prepared = self.prepare(objects);
@@ -576,7 +612,7 @@ impl CylinderTracker {
         let mut used = self.update_objects(&prepared, (&f, &q), &mut stats);
         let selected = match self.params.association {
             Association::Paper => self.select_new(&prepared, &mut used, &mut stats),
-            Association::Scalable | Association::Ground => {
+            Association::Scalable | Association::Ground | Association::Occupancy => {
                 self.select_new_scalable(&prepared, &mut used, &mut stats)
             }
         };

@@ -22,7 +22,10 @@
 //! `/tf_static`; per annotated frame, a `vision_msgs/Detection2DArray` per camera (every
 //! annotated box, class `person`, score 1, no id: the boxes carry no identity) and
 //! `/ground_truth/people` (id = `personID`, position from `positionID`). Frame `N` is stamped
-//! `T0 + N · 0.1 s` (the 10 fps extraction; annotated every 5th frame = 2 fps).
+//! `T0 + N · 0.1 s` (the 10 fps extraction; annotated every 5th frame = 2 fps). With
+//! [`write_noisy`] the detections are the annotated boxes through the seeded detector model of
+//! [`super::detector_noise`] (false boxes stand on the annotation's grid, [`ROOM_M`]); the
+//! ground truth stays the annotation.
 //!
 //! What the annotations do not give is filled in and said so: the person's height is the
 //! median over its views of where the ray through the box's top centre passes the person's
@@ -40,6 +43,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::{Isometry3, Point2, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
 
+use super::detector_noise::{self, DetectorNoise};
 use super::{ImportError, read_text};
 use crate::geometry::camera::{CameraModel, Pinhole};
 use crate::geometry::triangulate::CalibratedView;
@@ -440,18 +444,51 @@ pub fn people_frame(ds: &Dataset, k: usize) -> PeopleFrame {
     }
 }
 
+/// The annotation's ground grid `[x0, y0, x1, y1]` (m): where the false boxes of
+/// [`detector_noise`] stand.
+pub const ROOM_M: [f64; 4] = [-3.0, -9.0, 9.0, 27.0];
+
 /// The detections of camera `c` in frame `k` (every annotated box).
 pub fn detections(ds: &Dataset, k: usize, c: usize) -> Detection2DArray {
+    noisy_detections(ds, k, c, None)
+}
+
+/// [`detections`] through the detector model `(levels, seed)` of [`detector_noise`]
+/// (`None`: the annotated boxes as they are).
+pub fn noisy_detections(
+    ds: &Dataset,
+    k: usize,
+    c: usize,
+    noise: Option<(&DetectorNoise, u64)>,
+) -> Detection2DArray {
     let f = &ds.frames[k];
     let header = Header {
         stamp: Time::from_nanos(stamp(f.frame)),
         frame_id: camera_name(c),
     };
-    let detections = f
+    let annotated: Vec<[f64; 4]> = f
         .people
         .iter()
         .flat_map(|a| a.boxes.iter().filter(|b| b.0 == c))
-        .map(|&(_, b)| Detection2D {
+        .map(|&(_, b)| b)
+        .collect();
+    let boxes = match noise {
+        Some((n, seed)) => detector_noise::apply(
+            n,
+            seed,
+            &detector_noise::CameraFrame {
+                view: &ds.views[c],
+                camera: c,
+                stamp_ns: stamp(f.frame).0,
+                room_m: ROOM_M,
+            },
+            &annotated,
+        ),
+        None => annotated,
+    };
+    let detections = boxes
+        .into_iter()
+        .map(|b| Detection2D {
             header: header.clone(),
             results: vec![("person".to_string(), 1.0)],
             center_x: 0.5 * (b[0] + b[2]),
@@ -522,8 +559,24 @@ pub fn write(
     intr: Intrinsics,
     out: &Path,
 ) -> Result<ImportSummary, ImportError> {
+    write_noisy(ds, source, intr, None, out)
+}
+
+/// [`write`] with the detections through the detector model `(levels, seed)` (the ground
+/// truth stays the annotation); the levels and the seed go into the log's metadata.
+pub fn write_noisy(
+    ds: &Dataset,
+    source: &Path,
+    intr: Intrinsics,
+    noise: Option<(&DetectorNoise, u64)>,
+    out: &Path,
+) -> Result<ImportSummary, ImportError> {
     let mut w = SessionWriter::create(out, &WriterOptions::default())?;
     let mut meta = BTreeMap::new();
+    if let Some((n, seed)) = noise {
+        meta.insert("detector_noise".to_string(), n.label());
+        meta.insert("detector_noise_seed".to_string(), seed.to_string());
+    }
     meta.insert("dataset".to_string(), "wildtrack".to_string());
     meta.insert("source".to_string(), source.display().to_string());
     meta.insert("intrinsics".to_string(), intr.folder().to_string());
@@ -577,7 +630,7 @@ pub fn write(
         people_frames += gt.people.len();
         w.write_json(people, t, &gt)?;
         for (c, ch) in dets.iter().enumerate() {
-            let d = detections(ds, k, c);
+            let d = noisy_detections(ds, k, c, noise);
             boxes += d.detections.len();
             w.write(*ch, t, &d)?;
         }

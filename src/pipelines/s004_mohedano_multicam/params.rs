@@ -2,8 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::log::import::detector_noise::DetectorNoise;
 use crate::run::config::Invalid;
-use crate::track::cylinders::{Association, Selection};
+use crate::track::cylinders::{Association, OccupancyParams, Selection};
 
 /// Where the 2-D objects of the main run come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -109,6 +110,18 @@ pub struct Params {
     /// `scalable`: a single-camera ground point this close to a person already found is a
     /// view of that person (m).
     pub ground_separation_m: f64,
+    /// `occupancy`: the detector's model (`P_D`, edge jitter, false boxes per camera frame),
+    /// the prior density of people and the track scores (`track::cylinders::OccupancyParams`).
+    pub occupancy: OccupancyParams,
+    // detector noise (issue 32)
+    /// Levels of the detector model of `log::import::detector_noise` applied to the boxes of
+    /// the log (`detector = "log"`) or to the ground-truth boxes (otherwise), each run through
+    /// the 2-D tracker and the 3-D stage; empty: no `detector_noise` table.
+    pub detector_noise: Vec<DetectorNoise>,
+    /// Seed of the detector model's draws.
+    pub noise_seed: u64,
+    /// The associations each noise level is run with.
+    pub noise_associations: Vec<Association>,
     // evaluation
     /// Also run the configured association frame by frame without temporal tracking
     /// (detector `<detector>_per_frame`) and write the `ghosts` and `splits` tables.
@@ -177,6 +190,10 @@ impl Default for Params {
             max_combinations: 20_000,
             association: Association::Paper,
             ground_separation_m: 0.5,
+            occupancy: OccupancyParams::default(),
+            detector_noise: Vec::new(),
+            noise_seed: 1,
+            noise_associations: vec![Association::Ground, Association::Occupancy],
             decompose: false,
             split_frame: 0,
             match_m: vec![0.5, 1.0],
@@ -211,6 +228,24 @@ fn validate_shapes(p: &Params, bad: &mut impl FnMut(&str, String)) {
         bad(
             "nms_head_radius",
             format!("{} is not in (0, 5] body sizes", p.nms_head_radius),
+        );
+    }
+}
+
+/// The checks of `occupancy`, `detector_noise` and `noise_associations` (issue 32).
+fn validate_noise(p: &Params, bad: &mut impl FnMut(&str, String)) {
+    if let Err(e) = p.occupancy.validate() {
+        bad("occupancy", e.to_string());
+    }
+    for (k, n) in p.detector_noise.iter().enumerate() {
+        if let Err(e) = n.validate() {
+            bad("detector_noise", format!("level {}: {e}", k + 1));
+        }
+    }
+    if !p.detector_noise.is_empty() && p.noise_associations.is_empty() {
+        bad(
+            "noise_associations",
+            "needs at least one association to run the noise levels with".into(),
         );
     }
 }
@@ -332,6 +367,7 @@ pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
             format!("{} is not a finite distance ≥ 0 m", p.ground_separation_m),
         );
     }
+    validate_noise(p, &mut bad);
     if p.n_app_sweep.contains(&0) {
         bad("n_app_sweep", "values must be at least 1".into());
     }

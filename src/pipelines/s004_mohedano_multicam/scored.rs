@@ -15,8 +15,8 @@ use rayon::prelude::*;
 use super::Params;
 use super::session::{main_detector, selection_label};
 use super::tables::{
-    self, CalibRow, CameraRow, Det2dRow, Error2dRow, GtRow, HeadCentroidRow, SessionRow, TrackRow,
-    VariantRow,
+    self, CalibRow, CameraRow, Det2dRow, Error2dRow, GtRow, HeadCentroidRow, NoiseBoxRow,
+    SessionRow, TrackRow, VariantRow,
 };
 use crate::eval::mot::{Evaluation, Geometry, GroundPoint, MatchRule, Observation, evaluate};
 use crate::report::rows::Rows;
@@ -59,12 +59,28 @@ pub(crate) struct SessionData {
     pub view: Option<CachedView>,
     /// MEASURED: the main run's 3-D stage per frame.
     pub timing: Vec<tables::Timing3dRow>,
+    /// The detector-noise runs (empty without `detector_noise`).
+    pub noise_tracks: Vec<TrackRow>,
+    pub noise_boxes: Vec<NoiseBoxRow>,
 }
 
 impl SessionData {
     /// The rows of one run, in table order.
     pub fn rows(&self, key: &Key) -> Vec<&TrackRow> {
         self.tracks.iter().filter(|r| of(r, key)).collect()
+    }
+}
+
+/// A table only some configurations write: none when absent.
+fn read_optional<R: Rows>(
+    tables: &SessionTables,
+    name: &str,
+    session: &str,
+) -> anyhow::Result<Vec<R>> {
+    if tables.contains_key(name) {
+        read(tables, name, session)
+    } else {
+        Ok(Vec::new())
     }
 }
 
@@ -113,6 +129,8 @@ fn session_data(
         session,
         view,
         timing: read(t, tables::TIMING_3D, &label)?,
+        noise_tracks: read_optional(t, tables::NOISE_TRACKS, &label)?,
+        noise_boxes: read_optional(t, tables::NOISE_BOXES, &label)?,
     })
 }
 

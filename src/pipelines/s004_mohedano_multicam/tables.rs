@@ -22,6 +22,20 @@ pub(crate) const VIEW_IMAGE: &str = "view_image";
 /// That frame and the cylinders projected into it.
 pub(crate) const VIEW_SHAPES: &str = "view_shapes";
 pub(crate) const VIEW_FRAME: &str = "view_frame";
+/// The detector-noise runs' tracks (`TrackRow`: `detector` = the noise level, `selection` =
+/// the association) and each level's box counts; absent without `detector_noise`.
+pub(crate) const NOISE_TRACKS: &str = "noise_tracks";
+pub(crate) const NOISE_BOXES: &str = "noise_boxes";
+
+table_row! {
+    /// The boxes of one noise level in one session: before and after the detector model.
+    #[derive(Debug, Clone, PartialEq)]
+    pub(crate) struct NoiseBoxRow {
+        pub noise: String,
+        pub clean: i64,
+        pub noisy: i64,
+    }
+}
 
 table_row! {
     /// One 3-D track in one frame of one run (detector, selection rule, `N_app`).

@@ -42,11 +42,12 @@
 //! continued is dropped — the paper's `N_app` / `N_dis` with "the same person" meaning
 //! "within the gate on the ground" instead of "differs in at most one 2-D object".
 
-use nalgebra::{Matrix3, Point3, Vector3};
+use nalgebra::{Matrix3, Point3, Vector2, Vector3};
 
 use super::candidate::select_disjoint;
 use super::{
-    Cylinder, CylinderTracker, Hypothesis, Object2d, Prepared, StepStats, cylinder_radius,
+    Association, Cylinder, CylinderTracker, Hypothesis, Object2d, Prepared, StepStats,
+    cylinder_radius,
 };
 use crate::assign::min_cost_max_pairs;
 
@@ -58,6 +59,12 @@ const FIT_ITERATIONS: usize = 12;
 const PAIR_GATE: f64 = 4.0;
 /// Step of the numerical Jacobian (m).
 const JACOBIAN_STEP_M: f64 = 1e-6;
+
+/// A pixel difference with its coordinates multiplied by a box's residual weights (exact when
+/// they are 1).
+fn weighted(d: Vector2<f64>, w: [f64; 2]) -> Vector2<f64> {
+    Vector2::new(d.x * w[0], d.y * w[1])
+}
 
 impl CylinderTracker {
     /// The foot and head residuals (ideal px) of segment `(x, y, h)` in the boxes of `combo`,
@@ -74,7 +81,13 @@ impl CylinderTracker {
             let view = &self.views[o.camera];
             let foot = view.project_ideal(&Point3::new(s.x, s.y, 0.0))? - o.foot_ideal?;
             let head = view.project_ideal(&Point3::new(s.x, s.y, s.z))? - o.ideal;
-            r.extend([foot.x, foot.y, head.x, head.y]);
+            // the weights are 1 but under `Occupancy` (box uncertainty)
+            r.extend([
+                foot.x * o.w_foot[0],
+                foot.y * o.w_foot[1],
+                head.x * o.w_head[0],
+                head.y * o.w_head[1],
+            ]);
         }
         Some(r)
     }
@@ -168,14 +181,15 @@ impl CylinderTracker {
         })
     }
 
-    /// Grow a valid combination camera by camera while `E_c` falls.
+    /// Grow a valid combination camera by camera while `E_c` falls; with a `trail`, every
+    /// combination passed through (the seed included) is pushed onto it.
     fn grow_segment(
         &self,
         prepared: &[Prepared],
         by_cam: &[Vec<usize>],
-        mut combo: Vec<usize>,
-        mut best: Hypothesis,
+        (mut combo, mut best): (Vec<usize>, Hypothesis),
         stats: &mut StepStats,
+        mut trail: Option<&mut Vec<(Vec<usize>, Hypothesis)>>,
     ) -> (Vec<usize>, Hypothesis) {
         let gate = 2.0 * self.params.p_th_px;
         loop {
@@ -192,7 +206,7 @@ impl CylinderTracker {
                     let Some(f) = prepared[j].foot_ideal else {
                         continue;
                     };
-                    if (f - at).norm() > gate {
+                    if weighted(f - at, prepared[j].w_foot).norm() > gate {
                         continue;
                     }
                     let mut c = combo.clone();
@@ -208,8 +222,15 @@ impl CylinderTracker {
             }
             match step {
                 Some((s, c, h)) if s < best.e_c => {
-                    combo = c;
-                    best = h;
+                    if let Some(t) = trail.as_deref_mut() {
+                        t.push((
+                            std::mem::replace(&mut combo, c),
+                            std::mem::replace(&mut best, h),
+                        ));
+                    } else {
+                        combo = c;
+                        best = h;
+                    }
                 }
                 _ => return (combo, best),
             }
@@ -255,16 +276,35 @@ impl CylinderTracker {
         let mut seen = std::collections::BTreeSet::new();
         let mut in_grown: Vec<Vec<usize>> = vec![Vec::new(); prepared.len()];
         let mut valid: Vec<(f64, Vec<usize>, Hypothesis)> = Vec::new();
+        // `occupancy` keeps every seed and growth step as a candidate too (its module doc)
+        let keep_steps = self.params.association == Association::Occupancy;
+        let mut grown = 0;
         for (_, [i, j], h) in seeds {
             // both boxes already in one grown combination: this seed grows into it too
             if in_grown[i].iter().any(|g| in_grown[j].contains(g)) {
+                if keep_steps && seen.insert(vec![i, j]) {
+                    valid.push((h.e_c, vec![i, j], h));
+                }
                 continue;
             }
-            let (c, h) = self.grow_segment(prepared, &by_cam, vec![i, j], h, stats);
+            let mut trail = Vec::new();
+            let (c, h) = self.grow_segment(
+                prepared,
+                &by_cam,
+                (vec![i, j], h),
+                stats,
+                keep_steps.then_some(&mut trail),
+            );
+            for (tc, th) in trail {
+                if seen.insert(tc.clone()) {
+                    valid.push((th.e_c, tc, th));
+                }
+            }
             if seen.insert(c.clone()) {
                 for &k in &c {
-                    in_grown[k].push(valid.len());
+                    in_grown[k].push(grown);
                 }
+                grown += 1;
                 valid.push((h.e_c, c, h));
             }
         }
@@ -313,7 +353,9 @@ impl CylinderTracker {
             let head = view.project_ideal(&h.head_m);
             match (foot, head) {
                 (Some(a), Some(b)) => {
-                    0.5 * ((a - f).norm() + (b - o.ideal).norm()) <= factor * self.params.p_th_px
+                    0.5 * (weighted(a - f, o.w_foot).norm()
+                        + weighted(b - o.ideal, o.w_head).norm())
+                        <= factor * self.params.p_th_px
                 }
                 _ => false,
             }
@@ -407,4 +449,4 @@ impl CylinderTracker {
 }
 
 #[cfg(test)]
-mod tests;
+pub(super) mod tests;

@@ -1,6 +1,7 @@
 //! The evaluation, one file per sub-experiment, each with its tables (and figures where it
 //! has one): `tracks`, `clear_mot` (CLEAR MOT / IDF1 / HOTA at each threshold), `moda` (MODA / MODP), `decompose` (ghosts by cameras, development / held-out splits), `gt_boxes`
-//! (the 3-D stage on ground-truth boxes), `position` (position, height and radius errors),
+//! (the 3-D stage on ground-truth boxes), `noise` (the 3-D stage under the detector model's
+//! noise, issue 32), `position` (position, height and radius errors),
 //! `sweep` (`N_app` against latency and false alarms), `head_centroid` (t-test),
 //! `selection` (E_c vs E_m), `stages` (per-camera image stages), `detections_2d` (the
 //! template detector alone), `error_causes` (its misses and false detections by cause) and
@@ -14,6 +15,7 @@ mod error_causes;
 mod gt_boxes;
 mod head_centroid;
 mod moda;
+mod noise;
 mod position;
 mod search;
 mod selection;
@@ -36,6 +38,9 @@ pub(crate) fn evaluate(s: &Scored, p: &Params, products: &mut Products) -> anyho
         if p.decompose {
             products.tables.push(decompose::ghosts(s)?);
             products.tables.push(decompose::splits(s, p)?);
+        }
+        if !p.detector_noise.is_empty() {
+            products.tables.push(noise::table(s, p)?);
         }
         if let Some(t) = gt_boxes::table(s, &mut products.summary)? {
             products.tables.push(t);

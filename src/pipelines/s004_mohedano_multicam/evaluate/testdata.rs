@@ -91,6 +91,8 @@ pub(crate) fn session() -> SessionData {
         variants: Vec::new(),
         calibration: Vec::new(),
         timing: Vec::new(),
+        noise_tracks: Vec::new(),
+        noise_boxes: Vec::new(),
         session: SessionRow {
             frames: FRAMES,
             cameras: 2,

@@ -184,6 +184,7 @@ impl CameraChain {
             }
         };
         let c = self.camera;
+        let box_head = super::box_head_for_3d(p);
         out.objects = self
             .tracker
             .step(&boxes)
@@ -191,7 +192,11 @@ impl CameraChain {
             .map(|o| Object2d {
                 camera: c,
                 id: o.id,
-                head_px: o.head_px,
+                head_px: if box_head {
+                    boxes[o.detection].head_px
+                } else {
+                    o.head_px
+                },
                 width_px: o.width_px,
                 foot_px: Some([(o.bbox[0] + o.bbox[2]) / 2.0, o.bbox[3]]),
             })

@@ -49,10 +49,15 @@ pub(crate) fn gt_box_run(
                 .map(|(_, b)| b)
                 .collect();
             cams.push(boxes.iter().map(box_points).collect());
+            let box_head = super::box_head_for_3d(p);
             objs.extend(tr.step(&boxes).into_iter().map(|o| Object2d {
                 camera: c,
                 id: o.id,
-                head_px: o.head_px,
+                head_px: if box_head {
+                    boxes[o.detection].head_px
+                } else {
+                    o.head_px
+                },
                 width_px: o.width_px,
                 foot_px: Some([(o.bbox[0] + o.bbox[2]) / 2.0, o.bbox[3]]),
             }));

@@ -31,6 +31,7 @@ pub(crate) fn cylinder_params(
         max_combinations: p.max_combinations,
         association: p.association,
         ground_separation_m: p.ground_separation_m,
+        occupancy: p.occupancy,
         dt_s,
         ..CylinderParams::default()
     }

@@ -8,7 +8,7 @@ use crate::geometry::triangulate::CalibratedView;
 
 /// Seven 1920×1080 cameras (70° field of view) 6 m up on a circle of radius 14 m around a
 /// 12 × 12 m square, all looking at its centre.
-fn crowd_views() -> Vec<CalibratedView> {
+pub(in crate::track::cylinders) fn crowd_views() -> Vec<CalibratedView> {
     (0..7)
         .map(|k| {
             let a = std::f64::consts::TAU * f64::from(k) / 7.0;
@@ -33,7 +33,7 @@ fn params() -> CylinderParams {
 
 /// People 0.8 m apart and more (a dense crowd: 40 in 7 × 6 cells of 1.5 m, jittered
 /// deterministically), heights 1.55–1.95 m.
-fn crowd(n: usize) -> Vec<(u32, f64, f64, f64)> {
+pub(in crate::track::cylinders) fn crowd(n: usize) -> Vec<(u32, f64, f64, f64)> {
     (0..n)
         .map(|i| {
             let (gx, gy) = ((i % 7) as f64, (i / 7) as f64);
@@ -50,7 +50,10 @@ fn crowd(n: usize) -> Vec<(u32, f64, f64, f64)> {
 
 /// Noise-free feet and heads of every person in every camera whose image holds both; ids
 /// `1000·camera + person`.
-fn objects(views: &[CalibratedView], people: &[(u32, f64, f64, f64)]) -> Vec<Object2d> {
+pub(in crate::track::cylinders) fn objects(
+    views: &[CalibratedView],
+    people: &[(u32, f64, f64, f64)],
+) -> Vec<Object2d> {
     let mut out = Vec::new();
     for (c, v) in views.iter().enumerate() {
         for &(id, x, y, h) in people {
