@@ -259,6 +259,7 @@ fn figure(rows: &[MountRow]) -> Figure {
         Series::line(name, pts, color).with_mark(Mark::LinePoints)
     };
     let panel = |name: &str, title: &str, y: &str, series: Vec<Series>| {
+        let y_range = legend_headroom(&series);
         Figure::new(
             name.to_string(),
             title.to_string(),
@@ -266,6 +267,7 @@ fn figure(rows: &[MountRow]) -> Figure {
                 x_label: "camera height (m)".into(),
                 y_label: y.into(),
                 series,
+                y_range,
                 ..LinePlot::default()
             }),
         )
@@ -315,4 +317,35 @@ fn figure(rows: &[MountRow]) -> Figure {
             ],
         }),
     )
+}
+
+/// Share of a panel's data span left empty above the data, so the legend (drawn in the upper
+/// right) hides no point.
+const LEGEND_HEADROOM: f64 = 0.45;
+
+/// The y range of a panel: the data's span, with `LEGEND_HEADROOM` above it and a little below.
+fn legend_headroom(series: &[Series]) -> Option<(f64, f64)> {
+    let ys = series.iter().flat_map(|s| s.points.iter().map(|p| p.1));
+    let (lo, hi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| {
+        (lo.min(y), hi.max(y))
+    });
+    let span = (hi - lo).max(1e-3);
+    (lo.is_finite() && hi.is_finite()).then(|| (lo - 0.05 * span, hi + LEGEND_HEADROOM * span))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_legend_headroom_keeps_every_point_inside_and_leaves_the_top_empty() {
+        let s = |ys: &[f64]| Series::line("s", ys.iter().map(|&y| (1.0, y)).collect(), 1);
+        // Span 1 m from -0.5 to 0.5: 5 % below, 45 % above.
+        let (lo, hi) = legend_headroom(&[s(&[-0.5, 0.1]), s(&[0.5])]).expect("points");
+        assert!(
+            (lo - -0.55).abs() < 1e-12 && (hi - 0.95).abs() < 1e-12,
+            "{lo} {hi}"
+        );
+        assert_eq!(legend_headroom(&[s(&[])]), None);
+    }
 }
