@@ -244,3 +244,54 @@ fn a_crowd_is_numbered_after_the_scripted_people() {
     }
     assert_eq!(seen.into_iter().collect::<Vec<_>>(), vec![1, 2, 3]);
 }
+
+#[test]
+fn a_profile_gives_a_person_one_height_per_session_on_the_same_walk() {
+    // the tiny scenario as is, and with a profile that makes person 1 1.60 m tall in session 0
+    // and 1.95 m in session 1: the ground truth carries those heights (head centre 0.12 m
+    // below the top) and the walk is the same, stamp by stamp, as the plain scenario's
+    let truth = |path: &Path| -> Vec<(u64, f64, f64, f64, f64)> {
+        let log = SessionLog::open(path).expect("opens");
+        log.messages_on(&["/ground_truth/people"])
+            .expect("gt")
+            .map(|m| {
+                let m = m.expect("ok");
+                let f: PeopleFrame = serde_json::from_slice(&m.data).expect("valid");
+                let p = &f.people[0];
+                (m.log_time.0, p.x, p.y, p.height, p.head_z)
+            })
+            .collect()
+    };
+    let dir = tempfile::tempdir().expect("tempdir");
+    let plain = synth_into(&dir.path().join("plain"), 1);
+    let text = std::fs::read_to_string(scenario()).expect("fixture")
+        + "\n[[profiles.quick.people]]\nid = 1\nheights = [1.60, 1.95]\n";
+    let path = dir.path().join("heights_scenario.toml");
+    std::fs::write(&path, &text).expect("write");
+    let opts = |out: &str| SynthOptions {
+        profile: "quick".into(),
+        out: Some(dir.path().join(out)),
+        progress: None,
+    };
+    let tall = synthesize(&path, &opts("heights")).expect("synthesizes");
+    for (k, want) in [(0, 1.60), (1, 1.95)] {
+        let (a, b) = (truth(&plain[k]), truth(&tall.sessions[k]));
+        assert!(!a.is_empty() && a.len() == b.len());
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!((x.0, x.1, x.2), (y.0, y.1, y.2), "session {k}: same walk");
+            assert!((x.3 - 1.8).abs() < 1e-12 && (y.3 - want).abs() < 1e-12);
+            assert!(
+                (y.3 - y.4 - 0.12).abs() < 1e-9,
+                "head centre follows the height"
+            );
+        }
+    }
+    // an override naming no person is an error that names its key
+    let bad = text.replace("id = 1\nheights", "id = 7\nheights");
+    std::fs::write(&path, bad).expect("write");
+    let err = synthesize(&path, &opts("bad")).err().expect("refused");
+    assert!(
+        format!("{err:#}").contains("profiles.quick.people[0].id"),
+        "{err:#}"
+    );
+}

@@ -72,6 +72,20 @@ pub struct Meta {
 pub struct Profile {
     pub sessions: Option<u32>,
     pub duration_s: Option<f64>,
+    /// `[[profiles.<name>.people]]`: a scripted person's height per session in this profile
+    /// only (e.g. several people's heights in the full profile while the quick one keeps one).
+    #[serde(default)]
+    pub people: Vec<PersonOverride>,
+}
+
+/// What a profile changes of one scripted person.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PersonOverride {
+    /// The `[[people]]` entry's `id`.
+    pub id: u32,
+    /// Sets that person's `heights` (see [`PersonSpec::heights`]).
+    pub heights: Vec<f64>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -355,6 +369,10 @@ fn default_clearance() -> f64 {
 pub struct PersonSpec {
     pub id: u32,
     pub height: f64,
+    /// Height per session instead of `height`: session k has `heights[k mod len]` (the same
+    /// walk, motion and colours; only the body's size differs). Absent: `height` everywhere.
+    #[serde(default)]
+    pub heights: Option<Vec<f64>>,
     /// Body (shoulder) radius.
     #[serde(default = "default_width")]
     pub width: f64,
@@ -379,6 +397,16 @@ pub struct PersonSpec {
     /// (keeps working when a profile changes the duration).
     pub share: Option<[f64; 2]>,
     pub motion: Motion,
+}
+
+impl PersonSpec {
+    /// The person's height in session `session` (see `heights`).
+    pub fn height_in(&self, session: u64) -> f64 {
+        match &self.heights {
+            Some(h) if !h.is_empty() => h[(session % h.len() as u64) as usize],
+            _ => self.height,
+        }
+    }
 }
 
 fn default_width() -> f64 {
@@ -670,6 +698,16 @@ impl Scenario {
         if let Some(d) = p.duration_s {
             s.scenario.duration_s = d;
         }
+        for (i, o) in p.people.iter().enumerate() {
+            let Some(person) = s.people.iter_mut().find(|q| q.id == o.id) else {
+                return Err(ScenarioError::Invalid {
+                    path: path.to_path_buf(),
+                    key: format!("profiles.{profile}.people[{i}].id"),
+                    reason: format!("no [[people]] entry with id {}", o.id),
+                });
+            };
+            person.heights = Some(o.heights.clone());
+        }
         let dur = s.scenario.duration_s;
         for person in &mut s.people {
             if let Some([a, b]) = person.share {
@@ -714,6 +752,14 @@ impl Scenario {
                 return bad(
                     &format!("people[{i}].height"),
                     format!("{} m is not a person's height", p.height),
+                );
+            }
+            if let Some(h) = &p.heights
+                && (h.is_empty() || h.iter().any(|x| !(1.0..=2.4).contains(x)))
+            {
+                return bad(
+                    &format!("people[{i}].heights"),
+                    format!("{h:?}: give one or more heights, each in [1.0, 2.4] m"),
                 );
             }
             if let Motion::Waypoints { points, speed, .. } = &p.motion

@@ -1,6 +1,7 @@
-//! The aggregation: every session's filters ([`super::fusion`]), the height table with its
-//! one-sample t-test against the truth, position errors and lag per method with paired
-//! t-tests, and §4's plane grid averaged over the sessions.
+//! The aggregation: every session's filters ([`super::fusion`]), then position errors and lag
+//! per method with paired t-tests, our CV variant, and §4's plane grid averaged over the
+//! sessions (the height tables and camera only's constant-vs-walk tables read these runs in
+//! [`super::height`] and [`super::walk`]).
 
 use std::collections::BTreeMap;
 
@@ -28,50 +29,55 @@ pub struct SessionData {
     pub fig4: Vec<tables::Fig4Row>,
     /// Method name → run and its scores.
     pub runs: BTreeMap<&'static str, (Run, Vec<Scored>)>,
-    /// Session whose learned height the camera-only run starts from.
+    /// Session whose learned height the camera-only run starts from, and its true height.
     pub height_from: String,
+    pub height_from_truth_m: f64,
 }
 
 pub const FUSED: &str = "laser+camera";
 pub const LASER_ONLY: &str = "laser only";
 pub const CAMERA_ONLY: &str = "camera only";
 pub const FUSED_CV: &str = "laser+camera CV (ours)";
+/// The random-walk variant of the height (`q_height_walk`): laser + camera learns it, camera
+/// only starts from what that variant learned.
+pub const FUSED_WALK: &str = "laser+camera, height walk";
+pub const CAMERA_ONLY_WALK: &str = "camera only, height walk";
 
 /// Methods in table order.
-pub const METHODS: [&str; 4] = [FUSED, LASER_ONLY, CAMERA_ONLY, FUSED_CV];
+pub const METHODS: [&str; 6] = [
+    FUSED,
+    LASER_ONLY,
+    CAMERA_ONLY,
+    FUSED_CV,
+    FUSED_WALK,
+    CAMERA_ONLY_WALK,
+];
 
-table_row! {
-    /// Final height per session: `height`.
-    #[derive(Debug, Clone, PartialEq)]
-    pub struct HeightRow {
-        pub session: String,
-        pub truth_m: f64,
-        pub final_m: Option<f64>,
-        pub sigma_m: Option<f64>,
-        pub error_m: Option<f64>,
-        pub final_cv_m: Option<f64>,
-        pub camera_accepted: i64,
-        pub camera_rejected: i64,
-        pub laser_accepted: i64,
-        pub laser_rejected: i64,
-        pub first_camera_s: Option<f64>,
+impl SessionData {
+    /// A session with its observations and no filter run yet.
+    pub fn new(name: &str, laser: Vec<LaserObsRow>, camera: Vec<CameraObsRow>) -> SessionData {
+        SessionData {
+            name: name.into(),
+            laser,
+            camera,
+            truth: Vec::new(),
+            planes: Vec::new(),
+            fig4: Vec::new(),
+            runs: BTreeMap::new(),
+            height_from: String::new(),
+            height_from_truth_m: f64::NAN,
+        }
     }
-}
 
-table_row! {
-    /// One-sample t-test of the final heights against the truth: `height_ttest`.
-    #[derive(Debug, Clone, PartialEq)]
-    pub struct HeightTestRow {
-        pub sessions: i64,
-        pub truth_m: f64,
-        pub mean_m: Option<f64>,
-        pub std_m: Option<f64>,
-        pub t: Option<f64>,
-        pub p_two_sided: Option<f64>,
-        pub ci_low_m: Option<f64>,
-        pub ci_high_m: Option<f64>,
-        pub paper_m: f64,
-        pub paper_truth_m: f64,
+    /// The person's true height (first ground-truth stamp; NaN without truth).
+    pub fn truth_m(&self) -> f64 {
+        self.truth.first().map_or(f64::NAN, |t| t.height_m)
+    }
+
+    /// Mean position error of method `name` over its scored stamps.
+    pub fn mean_error(&self, name: &str) -> Option<f64> {
+        let e: Vec<f64> = self.runs.get(name)?.1.iter().map(|s| s.error_m).collect();
+        mean(&e)
     }
 }
 
@@ -126,37 +132,30 @@ table_row! {
     }
 }
 
-fn method(name: &'static str, learned: (f64, f64)) -> Method {
-    match name {
-        LASER_ONLY => Method {
-            name,
-            sensors: Sensors::LaserOnly,
-            motion: Motion::ConstantPosition,
-        },
-        CAMERA_ONLY => Method {
-            name,
-            sensors: Sensors::CameraOnly {
-                h_m: learned.0,
-                sigma_h_m: learned.1,
-            },
-            motion: Motion::ConstantPosition,
-        },
-        FUSED_CV => Method {
-            name,
-            sensors: Sensors::Fused,
-            motion: Motion::ConstantVelocity,
-        },
-        _ => Method {
-            name: FUSED,
-            sensors: Sensors::Fused,
-            motion: Motion::ConstantPosition,
-        },
+/// The filter configuration of method `name`; camera only starts from `learned` (height, σ)
+/// and its walk variant from `learned_walk`.
+pub fn method(name: &'static str, learned: (f64, f64), learned_walk: (f64, f64)) -> Method {
+    let (sensors, motion, walk) = match name {
+        LASER_ONLY => (Sensors::LaserOnly, Motion::ConstantPosition, false),
+        CAMERA_ONLY => (camera_only(learned), Motion::ConstantPosition, false),
+        FUSED_CV => (Sensors::Fused, Motion::ConstantVelocity, false),
+        FUSED_WALK => (Sensors::Fused, Motion::ConstantPosition, true),
+        CAMERA_ONLY_WALK => (camera_only(learned_walk), Motion::ConstantPosition, true),
+        _ => (Sensors::Fused, Motion::ConstantPosition, false),
+    };
+    Method {
+        name,
+        sensors,
+        motion,
+        walk,
     }
 }
 
-/// Read every session and run its filters; the camera-only run of session k starts from the
-/// height that laser + camera learned in session k − 1 (the first from the last; a single
-/// session from itself, said in the table).
+fn camera_only((h_m, sigma_h_m): (f64, f64)) -> Sensors {
+    Sensors::CameraOnly { h_m, sigma_h_m }
+}
+
+/// Read every session and run its filters ([`run_filters`]).
 pub fn load(ctx: &Aggregate, p: &Params) -> anyhow::Result<Vec<SessionData>> {
     let mut out = Vec::new();
     for (info, t) in ctx.sessions {
@@ -165,40 +164,50 @@ pub fn load(ctx: &Aggregate, p: &Params) -> anyhow::Result<Vec<SessionData>> {
         }
         let n = &info.name;
         out.push(SessionData {
-            name: n.clone(),
-            laser: tables::read(t, tables::LASER, n)?,
-            camera: tables::read(t, tables::CAMERA, n)?,
             truth: tables::read(t, tables::TRUTH, n)?,
             planes: tables::read(t, tables::PLANES, n)?,
             fig4: tables::read(t, tables::FIG4, n)?,
-            runs: BTreeMap::new(),
-            height_from: String::new(),
+            ..SessionData::new(
+                n,
+                tables::read(t, tables::LASER, n)?,
+                tables::read(t, tables::CAMERA, n)?,
+            )
         });
     }
-    let fused: Vec<Option<(f64, f64)>> = out
-        .iter()
-        .map(|s| {
-            let r = fusion::run(&s.laser, &s.camera, p, method(FUSED, (0.0, 0.0)));
-            r.last().map(|e| (e.h, e.sigma_h))
-        })
-        .collect();
-    let n = out.len();
-    for k in 0..n {
-        let from = (k + n - 1) % n;
-        let learned = fused[from].unwrap_or((p.h0_m, p.sigma_h0_m));
-        out[k].height_from = out[from].name.clone();
-        for name in METHODS {
-            let m = method(name, learned);
-            let s = &out[k];
-            let run = fusion::run(&s.laser, &s.camera, p, m);
-            let scored = fusion::score(&run, &s.truth, p, m.motion);
-            out[k].runs.insert(name, (run, scored));
-        }
-    }
+    run_filters(&mut out, p);
     Ok(out)
 }
 
-fn mean(v: &[f64]) -> Option<f64> {
+/// Every method on every session. The camera-only runs of session k start from the height
+/// (and σ) that laser + camera learned — with the constant height, and with the random walk
+/// for the walk variant — in session `height_from.source(k, n)`: the previous session, or its
+/// pair partner (a single session starts from itself, said in the tables).
+pub fn run_filters(data: &mut [SessionData], p: &Params) {
+    let learned = |s: &SessionData, name: &'static str| {
+        let r = fusion::run(&s.laser, &s.camera, p, method(name, (0.0, 0.0), (0.0, 0.0)));
+        r.last()
+            .map_or((p.h0_m, p.sigma_h0_m), |e| (e.h, e.sigma_h))
+    };
+    let fused: Vec<((f64, f64), (f64, f64))> = data
+        .iter()
+        .map(|s| (learned(s, FUSED), learned(s, FUSED_WALK)))
+        .collect();
+    let n = data.len();
+    for k in 0..n {
+        let from = p.height_from.source(k, n);
+        data[k].height_from = data[from].name.clone();
+        data[k].height_from_truth_m = data[from].truth_m();
+        for name in METHODS {
+            let m = method(name, fused[from].0, fused[from].1);
+            let s = &data[k];
+            let run = fusion::run(&s.laser, &s.camera, p, m);
+            let scored = fusion::score(&run, &s.truth, p, m.motion);
+            data[k].runs.insert(name, (run, scored));
+        }
+    }
+}
+
+pub fn mean(v: &[f64]) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
@@ -245,85 +254,9 @@ fn paired(data: &[SessionData], a: &str, b: &str) -> (Vec<f64>, Vec<f64>) {
     (xa, xb)
 }
 
-/// The result tables (see the module doc).
+/// The error, paired-test, CV and plane-grid tables (the height tables are
+/// [`super::height`]'s, the constant-vs-walk ones [`super::walk`]'s).
 pub fn tables(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow::Result<()> {
-    let mut heights = Vec::new();
-    for s in data {
-        let truth = s.truth.first().map_or(f64::NAN, |t| t.height_m);
-        let (run, _) = &s.runs[FUSED];
-        let last = run.last();
-        heights.push(HeightRow {
-            session: s.name.clone(),
-            truth_m: truth,
-            final_m: last.map(|e| e.h),
-            sigma_m: last.map(|e| e.sigma_h),
-            error_m: last.map(|e| e.h - truth),
-            final_cv_m: s.runs[FUSED_CV].0.last().map(|e| e.h),
-            camera_accepted: run.camera_accepted as i64,
-            camera_rejected: run.camera_rejected as i64,
-            laser_accepted: run.laser_accepted as i64,
-            laser_rejected: run.laser_rejected as i64,
-            first_camera_s: run
-                .first_camera_ns
-                .zip(run.estimates.first())
-                .map(|(c, e)| (c - e.stamp_ns) as f64 * 1e-9),
-        });
-    }
-    let finals: Vec<f64> = heights.iter().filter_map(|h| h.final_m).collect();
-    let truth = heights.first().map_or(f64::NAN, |h| h.truth_m);
-    let summary = stats::describe(&finals).ok();
-    let test = stats::paired_t(&finals, &vec![truth; finals.len()], p.level).ok();
-    let ttest = HeightTestRow {
-        sessions: finals.len() as i64,
-        truth_m: truth,
-        mean_m: mean(&finals),
-        std_m: summary.as_ref().map(|s| s.std),
-        t: test.as_ref().map(|t| t.t),
-        p_two_sided: test.as_ref().map(|t| t.p_two_sided),
-        ci_low_m: test.as_ref().map(|t| truth + t.ci_low),
-        ci_high_m: test.as_ref().map(|t| truth + t.ci_high),
-        paper_m: PAPER_HEIGHT_M,
-        paper_truth_m: PAPER_TRUTH_M,
-    };
-    let mut t = Table::new(
-        "height",
-        "Height learned by laser + camera at the end of each session vs the truth (seed 002 §6: 1.87 m vs 1.84 m)",
-        HeightRow::frame(&heights)?,
-    );
-    for c in [
-        "truth_m",
-        "final_m",
-        "sigma_m",
-        "error_m",
-        "final_cv_m",
-        "first_camera_s",
-    ] {
-        t = t.with_precision(c, 3);
-    }
-    out.tables.push(t.with_note(format!(
-        "EKF over (x, y, h), constant position, h0 = {} m with sigma {} m, 3-sigma gate (Mahalanobis <= {}); camera/laser accepted and rejected count observation events (a rejected camera event is one whose every detection implied a state outside the gate). first_camera_s: first camera detection after the filter started.",
-        p.h0_m, p.sigma_h0_m, p.gate_sigma
-    )));
-    let mut t = Table::new(
-        "height_ttest",
-        "Final heights over the sessions: mean, std and a one-sample t-test against the truth",
-        HeightTestRow::frame(&[ttest])?,
-    );
-    for c in [
-        "truth_m",
-        "mean_m",
-        "std_m",
-        "t",
-        "p_two_sided",
-        "ci_low_m",
-        "ci_high_m",
-    ] {
-        t = t.with_precision(c, 4);
-    }
-    out.tables.push(t.with_note(format!(
-        "Two-sided, level {}; the paper reports one trial ({PAPER_HEIGHT_M} m vs {PAPER_TRUTH_M} m), so it has no test.",
-        p.level
-    )));
     error_tables(data, p, out)
 }
 
@@ -333,7 +266,7 @@ fn error_tables(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow:
         let mut pooled: Vec<&Scored> = Vec::new();
         for s in data {
             let scored: Vec<&Scored> = s.runs[name].1.iter().collect();
-            let from = if name == CAMERA_ONLY {
+            let from = if name == CAMERA_ONLY || name == CAMERA_ONLY_WALK {
                 s.height_from.as_str()
             } else {
                 ""
@@ -352,8 +285,8 @@ fn error_tables(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow:
         t = t.with_precision(c, 3);
     }
     out.tables.push(t.with_note(format!(
-        "Scored at every ground-truth stamp from the filter's start with its latest estimate (constant velocity: extrapolated). lag_m: mean of (truth − estimate) along the true velocity while faster than {} m/s; positive = behind (the paper: 'position estimates lag slightly behind moving targets'). camera only starts from the height and sigma laser + camera learned in session camera_from. laser+camera CV is our addition (white-noise acceleration {} m²/s³).",
-        p.lag_min_speed, p.q_pos_cv
+        "Scored at every ground-truth stamp from the filter's start with its latest estimate (constant velocity: extrapolated). lag_m: mean of (truth − estimate) along the true velocity while faster than {} m/s; positive = behind (the paper: 'position estimates lag slightly behind moving targets'). camera only starts from the height and sigma laser + camera learned in session camera_from. laser+camera CV is our addition (white-noise acceleration {} m²/s³). Height: a constant the filter learns (q_height = {} m²/s, the paper's model); the 'height walk' rows a random walk of {} m²/s.",
+        p.lag_min_speed, p.q_pos_cv, p.q_height, p.q_height_walk
     )));
     let mut pairs = Vec::new();
     for (a, b) in [
@@ -361,6 +294,8 @@ fn error_tables(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow:
         (FUSED, CAMERA_ONLY),
         (LASER_ONLY, CAMERA_ONLY),
         (FUSED_CV, FUSED),
+        (CAMERA_ONLY, CAMERA_ONLY_WALK),
+        (FUSED, FUSED_WALK),
     ] {
         let (xa, xb) = paired(data, a, b);
         let test = stats::paired_t(&xa, &xb, p.level).ok();

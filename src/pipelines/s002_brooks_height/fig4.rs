@@ -157,6 +157,7 @@ pub fn compose(
         name: "laser+camera",
         sensors: Sensors::Fused,
         motion: Motion::ConstantPosition,
+        walk: false,
     };
     let run = fusion::run(&before_l, &before_c, p, m);
     let est = run.last().copied();

@@ -1,9 +1,12 @@
 //! The figures of seed 002 from the cached tables and the filter runs: fig. 3 (top view:
 //! room, sensors, estimated path and truth, with the final 3σ ellipse), figs. 5 and 6 (height
 //! over time with 3σ bounds, from the start and from the first camera observation), the
-//! position error over time per method, and §4's plane grid (time per frame, F1).
+//! position error over time per method, camera only's height over time (constant vs random
+//! walk), and §4's plane grid (time per frame, F1).
 
-use super::aggregate::{CAMERA_ONLY, FUSED, FUSED_CV, LASER_ONLY, METHODS, SessionData};
+use super::aggregate::{
+    CAMERA_ONLY, CAMERA_ONLY_WALK, FUSED, FUSED_CV, LASER_ONLY, METHODS, SessionData,
+};
 use super::params::{Params, plane_name};
 use crate::report::figure::{
     Figure, FigureKind, GroupedBars, ImageOverlay, LinePlot, Mark, Panels, Sensor, Series, TopView,
@@ -17,6 +20,7 @@ pub fn all(data: &[SessionData], p: &Params) -> Vec<Figure> {
         out.push(height(s, false));
         out.push(height(s, true));
         out.push(errors_over_time(s));
+        out.push(camera_only_height(s));
         out.extend(frame_panels(s));
     }
     if let Some(s) = data.get(1) {
@@ -130,7 +134,7 @@ fn height(s: &SessionData, from_camera: bool) -> Figure {
             )
         })
         .collect();
-    let truth = s.truth.first().map_or(f64::NAN, |t| t.height_m);
+    let truth = s.truth_m();
     let x_end = pts.last().map_or(1.0, |p| p.0);
     let x_start = pts.first().map_or(0.0, |p| p.0);
     let (fig, what, y_range) = if from_camera {
@@ -164,6 +168,48 @@ fn height(s: &SessionData, from_camera: bool) -> Figure {
             events: Vec::new(),
             x_range: None,
             y_range,
+        }),
+    )
+}
+
+/// Camera only's height over time with the constant height and the random walk (§5: the
+/// camera alone cannot observe it).
+fn camera_only_height(s: &SessionData) -> Figure {
+    let t0 = s.truth.first().map_or(0, |t| t.stamp_ns);
+    let mut series: Vec<Series> = [CAMERA_ONLY, CAMERA_ONLY_WALK]
+        .iter()
+        .enumerate()
+        .filter_map(|(k, name)| {
+            s.runs.get(name).map(|(run, _)| {
+                Series::line(
+                    *name,
+                    run.estimates
+                        .iter()
+                        .map(|e| (rel_s(e.stamp_ns, t0), e.h))
+                        .collect(),
+                    k + 1,
+                )
+            })
+        })
+        .collect();
+    if let (Some(a), Some(b)) = (s.truth.first(), s.truth.last()) {
+        series.push(
+            Series::line(
+                format!("truth {:.2} m", a.height_m),
+                vec![(0.0, a.height_m), (rel_s(b.stamp_ns, t0), a.height_m)],
+                0,
+            )
+            .with_mark(Mark::Dashed),
+        );
+    }
+    Figure::new(
+        format!("camera_only_height_{}", s.name),
+        format!("{}: camera only's height, constant vs random walk", s.name),
+        FigureKind::Lines(LinePlot {
+            x_label: "time (s)".into(),
+            y_label: "height (m)".into(),
+            series,
+            ..LinePlot::default()
         }),
     )
 }
@@ -262,7 +308,7 @@ fn planes(data: &[SessionData]) -> Figure {
 pub fn summary(data: &[SessionData]) -> Vec<String> {
     let mut out = Vec::new();
     for s in data {
-        let truth = s.truth.first().map_or(f64::NAN, |t| t.height_m);
+        let truth = s.truth_m();
         if let Some(e) = s.runs[FUSED].0.last() {
             out.push(format!(
                 "{}: height learned by laser + camera {:.3} m (σ {:.3}) vs truth {truth:.2} m (paper: 1.87 vs 1.84 m)",
@@ -278,12 +324,13 @@ pub fn summary(data: &[SessionData]) -> Vec<String> {
             }
         };
         out.push(format!(
-            "{}: mean position error laser+camera {:.3} m, laser only {:.3} m, camera only {:.3} m (height from {}), CV {:.3} m",
+            "{}: mean position error laser+camera {:.3} m, laser only {:.3} m, camera only {:.3} m (height from {}; {:.3} m with the height random walk), CV {:.3} m",
             s.name,
             mean(FUSED),
             mean(LASER_ONLY),
             mean(CAMERA_ONLY),
             s.height_from,
+            mean(CAMERA_ONLY_WALK),
             mean(FUSED_CV)
         ));
     }

@@ -1,7 +1,8 @@
 //! The filters of seed 002 §5 over one session's cached observations
 //! ([`crate::track::height_ekf`]): laser + camera, laser only, camera only (the height and its
-//! σ learned by laser + camera in another session, the paper's second trial), and our
-//! constant-velocity variant of laser + camera. Observations arrive in stamp order; of a
+//! σ learned by laser + camera in another session, the paper's second trial), each with the
+//! height a constant the filter learns (the paper) or a random walk (`walk`, a variant), and
+//! our constant-velocity variant of laser + camera. Observations arrive in stamp order; of a
 //! scan's leg pairs (or a frame's person detections) the one nearest the prediction
 //! (Mahalanobis) inside the 3σ gate updates the filter. Scored against the ground truth at its
 //! stamps with each filter's latest estimate (constant position: the estimate itself;
@@ -29,6 +30,8 @@ pub struct Method {
     pub name: &'static str,
     pub sensors: Sensors,
     pub motion: Motion,
+    /// The height a random walk (`q_height_walk`) instead of `q_height` (the paper: 0).
+    pub walk: bool,
 }
 
 /// The state after one observation event.
@@ -149,7 +152,11 @@ fn seconds(ns: i64) -> f64 {
 
 /// Run `m` over a session's observations.
 pub fn run(laser: &[LaserObsRow], cam: &[CameraObsRow], p: &Params, m: Method) -> Run {
-    let ekf = p.ekf(m.motion);
+    let ekf = if m.walk {
+        p.ekf_walk(m.motion)
+    } else {
+        p.ekf(m.motion)
+    };
     let mut out = Run::default();
     let mut f: Option<HeightEkf> = None;
     let mut last_accept_ns = i64::MIN;

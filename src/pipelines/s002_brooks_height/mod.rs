@@ -9,21 +9,28 @@
 //! histogram from the skin-training logs, hysteresis bounded by Canny edges, top-fifth test);
 //! §4's plane grid (1 / 3 colour × 0 / 1 / 2 edge planes) timed and scored; the ground truth.
 //! The aggregation ([`aggregate`]) runs the filters of [`fusion`] (§5: laser + camera, laser
-//! only, camera only from the height learned in the previous session, and our constant-
-//! velocity variant), and writes the height table with a one-sample t-test, position errors
-//! and lag with paired t-tests, the plane-grid table, and the figures ([`figures`]).
+//! only, camera only from the height learned in the previous session or its pair partner, the
+//! height a constant the filter learns — the paper — or a random walk — a variant — and our
+//! constant-velocity variant), and writes the height tables with one-sample t-tests
+//! ([`height`]), camera only with the constant height against the random walk ([`walk`]),
+//! position errors and lag with paired t-tests, the plane-grid table, and the figures
+//! ([`figures`]). `mode = "multi"`: several people ([`multi`]); `mode = "mount"`: the same
+//! filters once per camera of a mast of cameras at several heights ([`mount`]).
 
 mod aggregate;
 mod camera;
 mod fig4;
 mod figures;
 mod fusion;
+mod height;
+mod mount;
 mod multi;
 mod multi_report;
 mod multi_session;
 mod params;
 mod session;
 mod tables;
+mod walk;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -46,7 +53,7 @@ impl Experiment for BrooksHeight {
     }
 
     fn plan(p: &Params, _: &BTreeMap<String, String>) -> Vec<Stage> {
-        if p.mode == Mode::Multi {
+        if matches!(p.mode, Mode::Multi | Mode::Mount) {
             return multi_plan(p);
         }
         let (mask, _) = camera::mask_topics(&p.camera);
@@ -89,7 +96,7 @@ impl Experiment for BrooksHeight {
     ) -> anyhow::Result<SessionTables> {
         match p.mode {
             Mode::Paper => session::process(s, p, bar),
-            Mode::Multi => multi_session::process(s, p, bar),
+            Mode::Multi | Mode::Mount => multi_session::process(s, p, bar),
         }
     }
 
@@ -100,8 +107,16 @@ impl Experiment for BrooksHeight {
             multi_report::products(&r, p, &mut out)?;
             return Ok(out);
         }
+        if p.mode == Mode::Mount {
+            let cams = mount::compute(ctx, p)?;
+            let mut out = Products::default();
+            mount::products(&cams, p, &mut out)?;
+            return Ok(out);
+        }
         let data = aggregate::load(ctx, p)?;
         let mut out = Products::default();
+        height::tables(&data, p, &mut out)?;
+        walk::tables(&data, p, &mut out)?;
         aggregate::tables(&data, p, &mut out)?;
         out.figures.extend(figures::all(&data, p));
         out.summary.extend(figures::summary(&data));

@@ -3,14 +3,15 @@
 //! same), the head-top observations of each camera of `cameras` (the camera stage of
 //! [`super::camera`] run once per camera, with the skin histogram from that camera's view of
 //! the skin-training logs), and the ground truth of every person. No plane grid and no fig. 4
-//! (those are the paper run's).
+//! (those are the paper run's). Mount mode (one person seen by cameras at several heights)
+//! reads the same, plus the paper run's `truth` table of the one person.
 
 use anyhow::Context;
 
 use super::camera;
-use super::params::Params;
-use super::session::laser_observations;
-use super::tables::{self, CameraObsRow, LaserObsRow, PersonRow};
+use super::params::{Mode, Params};
+use super::session::{laser_observations, truth_rows};
+use super::tables::{self, CameraObsRow, LaserObsRow, PersonRow, TruthRow};
 use crate::frames::{rig, truth};
 use crate::groundtruth::PEOPLE_TOPIC;
 use crate::log::TfBuffer;
@@ -33,6 +34,9 @@ pub(super) fn process(
         out.insert(tables::PEOPLE_TRUTH.into(), PersonRow::frame(&[])?);
         for cam in &p.cameras {
             out.insert(tables::camera_table(cam), CameraObsRow::frame(&[])?);
+        }
+        if p.mode == Mode::Mount {
+            out.insert(tables::TRUTH.into(), TruthRow::frame(&[])?);
         }
         return Ok(out);
     }
@@ -71,5 +75,8 @@ pub(super) fn process(
         out.insert(tables::camera_table(cam), CameraObsRow::frame(&obs)?);
     }
     out.insert(tables::PEOPLE_TRUTH.into(), PersonRow::frame(&people)?);
+    if p.mode == Mode::Mount {
+        out.insert(tables::TRUTH.into(), TruthRow::frame(&truth_rows(&gt))?);
+    }
     Ok(out)
 }

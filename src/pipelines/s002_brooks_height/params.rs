@@ -24,6 +24,39 @@ pub enum Mode {
     /// Our addition: several people, laser + every camera of `cameras`, one EKF per person
     /// ([`crate::track::height_tracks`]); scored with CLEAR MOT and per-person heights.
     Multi,
+    /// The camera's mount: the paper's filters (one person) once per camera of `cameras`, the
+    /// same walks seen from cameras at several heights (`office_network_mount`).
+    Mount,
+}
+
+/// Which session's learned height the camera-only run of a session starts from (the paper's
+/// second trial uses the height learned in the first, by the same person).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HeightFrom {
+    /// The previous evaluated session (the first from the last): one person in every session.
+    Previous,
+    /// Sessions in pairs, (0, 1), (2, 3), ...: each trial starts from its partner's height (the
+    /// same person walks both; a last unpaired session falls back to the previous one).
+    Pairs,
+}
+
+impl HeightFrom {
+    /// The name in the pipeline file.
+    pub fn name(self) -> &'static str {
+        match self {
+            HeightFrom::Previous => "previous",
+            HeightFrom::Pairs => "pairs",
+        }
+    }
+
+    /// The session whose learned height session `k` of `n` starts from.
+    pub fn source(self, k: usize, n: usize) -> usize {
+        match self {
+            HeightFrom::Pairs if (k ^ 1) < n => k ^ 1,
+            _ => (k + n - 1) % n,
+        }
+    }
 }
 
 /// `[params]`.
@@ -67,7 +100,12 @@ pub struct Params {
     /// leg pair re-initialises the position there (velocity 0, height and its σ kept);
     /// 0 = never. The paper's constant-position filter never re-initialises.
     pub cv_reinit_after_s: f64,
+    /// Height process noise, m²/s: 0 = the paper's model (a constant the filter learns).
     pub q_height: f64,
+    /// The random-walk variant's height process noise (its own rows), m²/s.
+    pub q_height_walk: f64,
+    /// Which session's learned height the camera-only run starts from.
+    pub height_from: HeightFrom,
     pub sigma_range_m: f64,
     pub sigma_bearing_rad: f64,
     pub sigma_cam_bearing_rad: f64,
@@ -122,7 +160,9 @@ impl Default for Params {
             q_pos: 0.5,
             q_pos_cv: 2.0,
             cv_reinit_after_s: 1.0,
-            q_height: 1e-4,
+            q_height: 0.0,
+            q_height_walk: 1e-4,
+            height_from: HeightFrom::Previous,
             sigma_range_m: 0.1,
             sigma_bearing_rad: 0.02,
             sigma_cam_bearing_rad: 0.02,
@@ -205,6 +245,14 @@ impl Params {
         }
     }
 
+    /// The filter with the random-walk height instead (`q_height_walk`).
+    pub fn ekf_walk(&self, motion: Motion) -> EkfParams {
+        EkfParams {
+            q_height: self.q_height_walk,
+            ..self.ekf(motion)
+        }
+    }
+
     pub fn ekf(&self, motion: Motion) -> EkfParams {
         EkfParams {
             motion,
@@ -235,7 +283,7 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
     for (k, v) in [
         ("q_pos", p.q_pos),
         ("q_pos_cv", p.q_pos_cv),
-        ("q_height", p.q_height),
+        ("q_height_walk", p.q_height_walk),
         ("sigma_range_m", p.sigma_range_m),
         ("sigma_bearing_rad", p.sigma_bearing_rad),
         ("sigma_cam_bearing_rad", p.sigma_cam_bearing_rad),
@@ -253,6 +301,12 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
     ] {
         pos(k, v);
     }
+    if !(p.q_height.is_finite() && p.q_height >= 0.0) {
+        out.push((
+            "q_height".into(),
+            format!("{} must be >= 0 (0 = constant height)", p.q_height),
+        ));
+    }
     if !(p.alpha > 0.0 && p.alpha <= 1.0) {
         out.push(("alpha".into(), format!("{} is not in (0, 1]", p.alpha)));
     }
@@ -262,10 +316,10 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
             format!("{} must be >= 0 (0 = never)", p.cv_reinit_after_s),
         ));
     }
-    if p.mode == Mode::Multi && p.cameras.is_empty() {
+    if matches!(p.mode, Mode::Multi | Mode::Mount) && p.cameras.is_empty() {
         out.push((
             "cameras".into(),
-            "mode = \"multi\" needs at least one camera".into(),
+            "mode = \"multi\" and mode = \"mount\" need at least one camera".into(),
         ));
     }
     if !(p.level > 0.0 && p.level < 1.0) {
@@ -381,5 +435,30 @@ mod tests {
         assert_eq!(p.training_logs(&s0), vec![dir.path().join("d_02.mcap")]);
         assert!(!p.is_training(&s0));
         assert!(p.is_training(&dir.path().join("d_02.mcap")));
+    }
+
+    #[test]
+    fn camera_only_height_sources_previous_and_pairs() {
+        let all = |h: HeightFrom, n: usize| (0..n).map(|k| h.source(k, n)).collect::<Vec<_>>();
+        assert_eq!(all(HeightFrom::Previous, 5), [4, 0, 1, 2, 3]);
+        assert_eq!(all(HeightFrom::Pairs, 6), [1, 0, 3, 2, 5, 4]);
+        // an odd last session falls back to the previous one; two sessions: the rules agree
+        assert_eq!(all(HeightFrom::Pairs, 5), [1, 0, 3, 2, 3]);
+        assert_eq!(all(HeightFrom::Pairs, 2), all(HeightFrom::Previous, 2));
+        assert_eq!(all(HeightFrom::Pairs, 1), [0]);
+    }
+
+    #[test]
+    fn a_constant_height_is_valid_and_a_negative_one_is_not() {
+        let p = Params::default();
+        assert_eq!((p.q_height, p.q_height_walk), (0.0, 1e-4));
+        assert!(validate(&p).is_empty());
+        let bad = Params {
+            q_height: -1e-4,
+            q_height_walk: 0.0,
+            ..Params::default()
+        };
+        let keys: Vec<String> = validate(&bad).into_iter().map(|(k, _)| k).collect();
+        assert_eq!(keys, ["q_height_walk", "q_height"]);
     }
 }

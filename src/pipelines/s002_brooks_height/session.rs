@@ -15,8 +15,9 @@ use super::params::Params;
 use super::tables::{self, LaserObsRow, TruthRow};
 use super::{camera, fig4};
 use crate::frames::laser::{self as laser_frames, LaserOptions};
+use crate::frames::truth::Stamped;
 use crate::frames::{rig, truth};
-use crate::groundtruth::PEOPLE_TOPIC;
+use crate::groundtruth::{PEOPLE_TOPIC, PeopleFrame};
 use crate::laser::legs::{self, LegParams};
 use crate::laser::points::{self, ScanGeometry};
 use crate::laser::segment::{self, SegmentOptions};
@@ -61,6 +62,22 @@ pub(super) fn laser_observations(log: &SessionLog, p: &Params) -> anyhow::Result
     Ok(out)
 }
 
+/// The (first) person's ground truth at every stamp.
+pub(super) fn truth_rows(gt: &Stamped<PeopleFrame>) -> Vec<TruthRow> {
+    gt.iter()
+        .filter_map(|(t, f)| {
+            f.people.first().map(|person| TruthRow {
+                stamp_ns: i64::try_from(t.0).unwrap_or(i64::MAX),
+                x: person.x,
+                y: person.y,
+                vx: person.vx,
+                vy: person.vy,
+                height_m: person.height,
+            })
+        })
+        .collect()
+}
+
 /// Process one session (see the module doc).
 pub(super) fn process(
     s: &Session,
@@ -84,19 +101,7 @@ pub(super) fn process(
     }
     let (gt, _) = truth::people(log, PEOPLE_TOPIC)
         .with_context(|| format!("{file}: ground truth {PEOPLE_TOPIC}"))?;
-    let truth_rows: Vec<TruthRow> = gt
-        .iter()
-        .filter_map(|(t, f)| {
-            f.people.first().map(|person| TruthRow {
-                stamp_ns: i64::try_from(t.0).unwrap_or(i64::MAX),
-                x: person.x,
-                y: person.y,
-                vx: person.vx,
-                vy: person.vy,
-                height_m: person.height,
-            })
-        })
-        .collect();
+    let truth_rows = truth_rows(&gt);
     bar.set_message("laser");
     let laser = laser_observations(log, p)?;
     bar.set_message("camera");

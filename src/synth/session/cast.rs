@@ -290,7 +290,10 @@ fn actors(
     let mut out = Vec::new();
     for p in &s.people {
         out.push(Actor {
-            body: Body::from_spec(p),
+            body: Body {
+                height: p.height_in(session),
+                ..Body::from_spec(p)
+            },
             track: scripted_track(s, p, world, base, session)?,
         });
     }
