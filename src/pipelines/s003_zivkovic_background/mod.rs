@@ -147,7 +147,9 @@ impl Experiment for BackgroundTracking {
         colour_report::products(ctx, p, &mut products)?;
         local_tracks::products(ctx, p, &mut products)?;
         moving::products(ctx, p, &mut products)?;
-        reid_report::products(ctx, p, &mut products)?;
+        if let Some((runs, training)) = reid_report::products(ctx, p, &mut products)? {
+            reid_summary::products(&runs, &training, &p.reid, &mut products)?;
+        }
         reid_figures::products(ctx, &p.reid, &mut products)?;
         reid_snapshots::products(ctx, &p.reid, &mut products)?;
         wallflower::products(p, &mut products)?;

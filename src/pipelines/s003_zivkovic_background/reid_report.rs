@@ -3,9 +3,9 @@
 //! each clip of every scored session filtered online in order of the tracks' ends by every
 //! method (`reid_methods`) on ground-truth local tracks and on the system's own, and scored
 //! by `eval::reid`. Tables: `reid` (per session, clip, source, method), `reid_observations`
-//! (every observation's label: every metric can be recomputed from it), `reid_retrieval`,
-//! and through `reid_summary` the pooled table, the t-tests across sessions, the training
-//! split's fitted values and the paper's goals.
+//! (every observation's label: every metric can be recomputed from it), `reid_retrieval`;
+//! its runs go on to `reid_summary` (the pooled table, the t-tests across sessions, the
+//! training split's fitted values and the paper's goals).
 
 use std::collections::BTreeMap;
 
@@ -13,7 +13,6 @@ use super::params::{ClipParams, Params, ReidParams};
 use super::reid::{FRAMES_TABLE, ReidFrameRow};
 use super::reid_features::{Feature, Observation, observations};
 use super::reid_methods::{METHODS, Method, Training, labels};
-use super::reid_summary;
 use crate::eval::reid::{retrieval, score};
 use crate::report::Table;
 use crate::report::rows::Rows;
@@ -281,11 +280,17 @@ fn runs(scored: &[SessionObs], p: &ReidParams, training: &Training) -> anyhow::R
     Ok(out)
 }
 
-pub(super) fn products(ctx: &Aggregate, p: &Params, products: &mut Products) -> anyhow::Result<()> {
+/// The per-session tables; the runs and what the training split fitted come back for
+/// `reid_summary` (`None`: no scored session).
+pub(super) fn products(
+    ctx: &Aggregate,
+    p: &Params,
+    products: &mut Products,
+) -> anyhow::Result<Option<(Runs, Training)>> {
     let r = &p.reid;
     let scored = sessions_of(ctx, &r.datasets, r)?;
     if scored.is_empty() {
-        return Ok(());
+        return Ok(None);
     }
     let training = training(ctx, r)?;
     let runs = runs(&scored, r, &training)?;
@@ -321,7 +326,7 @@ pub(super) fn products(ctx: &Aggregate, p: &Params, products: &mut Products) -> 
             .with_precision("map", 3)
             .with_note("Euclidean distance between the tracks' mean 9-D features; queries = tracks whose person has another track in the clip with the feature. Not in the paper (our addition, the usual re-identification measure)."),
     );
-    reid_summary::products(&runs, &training, r, products)
+    Ok(Some((runs, training)))
 }
 
 #[cfg(test)]
