@@ -41,9 +41,9 @@
 //! [`shared::Frame`] to one state struct per sub-experiment, and the `sessions` table),
 //! `shared` (the frame, the `session` row, grouping by dataset), one file per sub-experiment holding
 //! its per-frame state, cached tables, result tables and figures (`roc` + `roc_report`, `timing`,
-//! `components`, `colour` + `colour_report`, `local_tracks`, `moving`, `reid` + `reid_params`
-//! + `reid_features` + `reid_methods` + `reid_report` + `reid_summary` + `reid_figures` +
-//! `reid_snapshots` (+ `snapshots`), `wallflower`).
+//! `components`, `colour` + `colour_report`, `local_tracks`, `moving`, `reid` with
+//! `reid_params`, `reid_features`, `reid_methods`, `reid_report`, `reid_summary`,
+//! `reid_figures` and `reid_snapshots` (+ `snapshots`), `wallflower`).
 
 mod colour;
 mod colour_report;

@@ -274,8 +274,8 @@ pub(super) fn nearest(obs: &[&Observation], feature: Feature, threshold: f64) ->
             }
         };
         let person = &mut people[i];
-        for j in 0..9 {
-            person.0[j] += x[j];
+        for (acc, v) in person.0.iter_mut().zip(x) {
+            *acc += v;
         }
         person.1 += 1.0;
         person.2 = person.2.max(o.span.leave);

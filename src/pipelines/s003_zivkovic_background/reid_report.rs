@@ -339,8 +339,13 @@ mod tests {
 
     /// Person `truth` seen from `enter` for 1 s, channel-normalised look `base` ± 0.02.
     fn look(truth: i64, enter: f64, base: f64, k: usize) -> Observation {
-        let x: [f64; 9] =
-            std::array::from_fn(|j| base + if (j + k) % 2 == 0 { 0.02 } else { -0.02 });
+        let x: [f64; 9] = std::array::from_fn(|j| {
+            base + if (j + k).is_multiple_of(2) {
+                0.02
+            } else {
+                -0.02
+            }
+        });
         Observation {
             id: truth,
             truth: Some(truth),

@@ -401,7 +401,13 @@ fn far_from_the_printed_a0_two_people_merge_and_the_moved_prior_tells_them_apart
     let r = 9;
     let look = |base: f64, k: usize| -> Vec<f64> {
         (0..r)
-            .map(|j| base + if (j + k) % 2 == 0 { 0.02 } else { -0.02 })
+            .map(|j| {
+                base + if (j + k).is_multiple_of(2) {
+                    0.02
+                } else {
+                    -0.02
+                }
+            })
             .collect()
     };
     let seq = [(0.9, 0), (1.2, 0), (0.9, 1), (1.2, 1)];
