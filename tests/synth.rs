@@ -295,3 +295,68 @@ fn a_profile_gives_a_person_one_height_per_session_on_the_same_walk() {
         "{err:#}"
     );
 }
+
+#[test]
+fn the_id_mask_names_each_persons_pixels_and_a_profile_can_start_at_any_session() {
+    // the tiny scenario with the per-person id mask on cam_0 and a profile of one session
+    // starting at session 7
+    let dir = tempfile::tempdir().expect("tempdir");
+    let text = std::fs::read_to_string(scenario())
+        .expect("fixture")
+        .replace("mask = true\n", "mask = true\nid_mask = true\n")
+        .replace(
+            "[profiles.quick]\n",
+            "[profiles.later]\nsessions = 1\nfirst_session = 7\n\n[profiles.quick]\n",
+        );
+    let path = dir.path().join("ids_scenario.toml");
+    std::fs::write(&path, text).expect("write");
+    let summary = synthesize(
+        &path,
+        &SynthOptions {
+            profile: "later".into(),
+            out: Some(dir.path().join("out")),
+            progress: None,
+        },
+    )
+    .expect("synthesizes");
+    assert_eq!(summary.sessions.len(), 1);
+    assert!(summary.sessions[0].ends_with("tiny_07.mcap"));
+    let log = SessionLog::open(&summary.sessions[0]).expect("opens");
+    let read = |topic: &str| -> Vec<Image> {
+        read_topic::<Image>(&log, topic)
+            .expect("topic")
+            .map(|r| r.expect("ok").1)
+            .collect()
+    };
+    let (masks, ids) = (
+        read("/cam_0/ground_truth_mask"),
+        read("/cam_0/ground_truth_ids"),
+    );
+    assert_eq!(masks.len(), ids.len());
+    let mut person_pixels = 0;
+    for (m, i) in masks.iter().zip(&ids) {
+        assert_eq!(m.header.stamp, i.header.stamp);
+        assert_eq!((i.encoding.as_str(), i.width, i.height), ("mono8", 64, 48));
+        for (&u, &id) in m.data.iter().zip(&i.data) {
+            // person 1 is the only person: its id exactly where the union mask is set
+            assert_eq!(id, if u == 255 { 1 } else { 0 });
+        }
+        person_pixels += i.data.iter().filter(|v| **v == 1).count();
+    }
+    assert!(person_pixels > 100, "only {person_pixels} person pixels");
+    // session 7's own seed: unlike session 0 of the quick profile
+    let quick = synthesize(
+        &path,
+        &SynthOptions {
+            profile: "quick".into(),
+            out: Some(dir.path().join("quick")),
+            progress: None,
+        },
+    )
+    .expect("synthesizes");
+    assert!(quick.sessions[0].ends_with("tiny_00.mcap"));
+    assert_ne!(
+        std::fs::read(&quick.sessions[0]).expect("00"),
+        std::fs::read(&summary.sessions[0]).expect("07")
+    );
+}

@@ -3,7 +3,10 @@
 //!
 //! - Seed 003's two measures: mis-identified observations (after the one-to-one mapping of
 //!   labels to people that agrees most often, found exactly with `assign::max_count_pairs`)
-//!   and the error in the number of distinct people.
+//!   and the error in the number of distinct people; and its way of counting people (§V: "one
+//!   out of five encountered persons was wrongly identified as a new individual"): people
+//!   *wrongly new* — an observation of theirs got a label no person maps to, a new individual
+//!   — and people *merged* — an observation of theirs got the label of another person.
 //! - Pairwise precision / recall / F1 over all pairs of observations ("same person?").
 //! - The adjusted Rand index (Hubert & Arabie 1985) from the contingency table.
 //! - Retrieval: rank-1 and mean average precision, each observation querying all the others.
@@ -25,6 +28,12 @@ pub struct ReidScores {
     pub found_people: usize,
     /// found − true (the paper's error in the number of distinct people; signed).
     pub people_error: i64,
+    /// People with an observation labelled as nobody's (a new individual).
+    pub wrongly_new: usize,
+    /// People with an observation labelled as another person.
+    pub merged: usize,
+    /// People with either (each counted once).
+    pub people_wrong: usize,
     pub pair_precision: f64,
     pub pair_recall: f64,
     pub pair_f1: f64,
@@ -70,10 +79,22 @@ pub fn score<T: Ord, L: Ord>(truth: &[T], labels: &[L]) -> ReidScores {
                 .map(move |(c, count)| (r, c, *count))
         })
         .collect();
-    let matched: u64 = max_count_pairs(rows, cols, &edges)
-        .into_iter()
-        .map(|(r, c)| table[r][c])
-        .sum();
+    let pairs_found = max_count_pairs(rows, cols, &edges);
+    let matched: u64 = pairs_found.iter().map(|&(r, c)| table[r][c]).sum();
+    // person of each label under the mapping (None: a label no person maps to)
+    let mut person_of = vec![None; cols];
+    for &(r, c) in &pairs_found {
+        person_of[c] = Some(r);
+    }
+    let (mut wrongly_new, mut merged, mut people_wrong) = (0, 0, 0);
+    for (r, row) in table.iter().enumerate() {
+        let off = |c: usize| row[c] > 0 && person_of[c] != Some(r);
+        let new = (0..cols).any(|c| off(c) && person_of[c].is_none());
+        let other = (0..cols).any(|c| off(c) && person_of[c].is_some());
+        wrongly_new += usize::from(new);
+        merged += usize::from(other);
+        people_wrong += usize::from(new || other);
+    }
     let same_both: f64 = table.iter().flatten().map(|&c| pairs(c)).sum();
     let same_truth: f64 = table.iter().map(|row| pairs(row.iter().sum())).sum();
     let same_label: f64 = (0..cols)
@@ -100,6 +121,9 @@ pub fn score<T: Ord, L: Ord>(truth: &[T], labels: &[L]) -> ReidScores {
         true_people: rows,
         found_people: cols,
         people_error: cols as i64 - rows as i64,
+        wrongly_new,
+        merged,
+        people_wrong,
         pair_precision: precision,
         pair_recall: recall,
         pair_f1: f1,
@@ -195,11 +219,28 @@ mod tests {
         let s = score(&truth, &labels);
         assert_eq!((s.misidentified, s.true_people, s.found_people), (1, 5, 6));
         assert_eq!(s.people_error, 1);
+        assert_eq!((s.wrongly_new, s.merged, s.people_wrong), (1, 0, 1));
         // same-person pairs: (1,1) and (4,4); the labelling keeps (1,1) only
         assert_eq!((s.pair_precision, s.pair_recall), (1.0, 0.5));
         assert!((s.pair_f1 - 2.0 / 3.0).abs() < 1e-15);
         // scikit-learn 1.9.1: adjusted_rand_score(truth, labels)
         assert!((s.adjusted_rand - 0.6440677966101694).abs() < 1e-12);
+    }
+
+    #[test]
+    fn people_merged_and_wrongly_new_counted_once_each() {
+        // person 2's second look joins person 1; person 3's third look is a new label;
+        // person 4 has one of each: 3 of 4 people wrong, one of them both ways
+        let truth = [1, 1, 2, 2, 3, 3, 3, 4, 4, 4, 4];
+        let labels = [1, 1, 2, 1, 3, 3, 5, 4, 4, 6, 3];
+        let s = score(&truth, &labels);
+        // the one best mapping: 1→1, 2→2, 3→3, 4→4; labels 5 and 6 are nobody's
+        assert_eq!(s.misidentified, 4);
+        assert_eq!((s.wrongly_new, s.merged, s.people_wrong), (2, 2, 3));
+        assert_eq!(s.people_error, 2);
+        // a perfect labelling has nobody wrong
+        let p = score(&[1, 2, 1], &[7, 8, 7]);
+        assert_eq!((p.wrongly_new, p.merged, p.people_wrong), (0, 0, 0));
     }
 
     #[test]

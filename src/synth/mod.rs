@@ -52,7 +52,7 @@ pub struct SynthOptions {
 pub struct SynthSummary {
     pub name: String,
     pub sessions: Vec<PathBuf>,
-    /// One instant of the first session (none when the scenario has no sessions).
+    /// One instant of the profile's first session (none when the scenario has no sessions).
     pub preview: Option<PreviewData>,
 }
 
@@ -79,9 +79,9 @@ pub fn synthesize(scenario_path: &Path, opts: &SynthOptions) -> anyhow::Result<S
         .parent()
         .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
     let bars = crate::progress::reporter(&opts.progress);
-    let results: Vec<anyhow::Result<(PathBuf, Option<session::PreviewData>)>> = (0..s
-        .scenario
-        .sessions)
+    let first = s.scenario.first_session;
+    let results: Vec<anyhow::Result<(PathBuf, Option<session::PreviewData>)>> = (first
+        ..first + s.scenario.sessions)
         .into_par_iter()
         .map(|k| {
             let path = out.join(format!("{}_{:02}.mcap", s.scenario.name, k));
@@ -95,7 +95,7 @@ pub fn synthesize(scenario_path: &Path, opts: &SynthOptions) -> anyhow::Result<S
                     session::write_session(&s, &text, &opts.profile, &base, k, &path, bar.as_ref())?
                 }
             };
-            Ok((path, (k == 0).then_some(preview)))
+            Ok((path, (k == first).then_some(preview)))
         })
         .collect();
     let mut sessions = Vec::new();

@@ -64,6 +64,11 @@ pub struct Meta {
     #[serde(default = "default_sessions")]
     pub sessions: u32,
     pub duration_s: f64,
+    /// Index of the first session (its seed streams and file name `<name>_NN`); later ones
+    /// follow. A profile may start elsewhere so that its sessions are others than the quick
+    /// profile's (a held-out set, a training split).
+    #[serde(default)]
+    pub first_session: u32,
 }
 
 /// `[profiles.<name>]`: what a profile changes.
@@ -72,6 +77,9 @@ pub struct Meta {
 pub struct Profile {
     pub sessions: Option<u32>,
     pub duration_s: Option<f64>,
+    /// The profile's sessions are `first_session`, `first_session + 1`, … (default: the
+    /// scenario's, 0).
+    pub first_session: Option<u32>,
     /// `[[profiles.<name>.people]]`: a scripted person's height per session in this profile
     /// only (e.g. several people's heights in the full profile while the quick one keeps one).
     #[serde(default)]
@@ -422,6 +430,21 @@ fn default_hair() -> Rgb {
     [60, 42, 30]
 }
 
+/// `[variation]`: what makes one session's visitors unlike another's, besides the random
+/// streams of their walks. From session `from_session` on, every scripted person's top, trousers
+/// and hair are drawn from the synthesizer's clothing palette (`clothes`; the tops all
+/// different within a session, as visitors a robot should tell apart), and a random number in
+/// `absent` (inclusive) of them stay away. Earlier sessions keep the cast as written.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Variation {
+    pub from_session: u32,
+    #[serde(default)]
+    pub clothes: bool,
+    #[serde(default)]
+    pub absent: [u32; 2],
+}
+
 /// `[crowd]`: people generated at random — visitors coming through doors, passers-by.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -554,6 +577,10 @@ pub struct CameraCommon {
     /// seed 002's skin histogram is trained and scored on).
     #[serde(default)]
     pub skin_mask: bool,
+    /// Also publish whose pixel each pixel is, `/<name>/ground_truth_ids` (`mono8`: the person's
+    /// id, 0 where no person is seen, 255 for ids of 255 and above): a per-person exact mask.
+    #[serde(default)]
+    pub id_mask: bool,
 }
 
 fn default_noise() -> f64 {
@@ -664,6 +691,7 @@ pub struct Scenario {
     #[serde(default)]
     pub people: Vec<PersonSpec>,
     pub crowd: Option<Crowd>,
+    pub variation: Option<Variation>,
     pub robot: Robot,
     #[serde(default)]
     pub sensors: Vec<SensorSpec>,
@@ -697,6 +725,9 @@ impl Scenario {
         }
         if let Some(d) = p.duration_s {
             s.scenario.duration_s = d;
+        }
+        if let Some(f) = p.first_session {
+            s.scenario.first_session = f;
         }
         for (i, o) in p.people.iter().enumerate() {
             let Some(person) = s.people.iter_mut().find(|q| q.id == o.id) else {
@@ -736,6 +767,16 @@ impl Scenario {
         }
         if m.sessions == 0 {
             return bad("scenario.sessions", "must be at least 1".into());
+        }
+        if m.first_session.saturating_add(m.sessions) > 10_000 {
+            return bad(
+                "scenario.first_session",
+                format!(
+                    "sessions {}..{} reach past 10000",
+                    m.first_session,
+                    u64::from(m.first_session) + u64::from(m.sessions)
+                ),
+            );
         }
         if !(self.world.size[0] > 0.0 && self.world.size[1] > 0.0) {
             return bad("world.size", "both extents must be positive".into());
@@ -829,6 +870,18 @@ impl Scenario {
         }
         if let Some((key, reason)) = self.biron.as_ref().and_then(BironSpec::problem) {
             return bad(&format!("biron.{key}"), reason);
+        }
+        if let Some(v) = &self.variation
+            && (v.absent[0] > v.absent[1] || v.absent[1] as usize >= self.people.len().max(1))
+        {
+            return bad(
+                "variation.absent",
+                format!(
+                    "{:?} must be [least, most] with most below the {} scripted people",
+                    v.absent,
+                    self.people.len()
+                ),
+            );
         }
         if let Some(c) = &self.calibration
             && !self.people.iter().any(|p| p.id == c.person)

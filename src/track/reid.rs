@@ -69,6 +69,79 @@ impl Prior {
         }
     }
 
+    /// The prior moved to the units of the features (our addition, not in the paper), fitted
+    /// on `people` (looks grouped by person); η₀ stays, r = the looks' dimension:
+    /// - a₀ at the mean of every look;
+    /// - κ₀ = s_b²/s_w² (at least [`KAPPA0_MIN`]): the printed prior draws a person's mean as
+    ///   m ~ N(a₀, κ₀V), so κ₀ is the spread of people's means over the spread of one person's
+    ///   looks. s_w² is the pooled within-person variance per dimension (a person seen once
+    ///   adds nothing to it), s_b² the variance of the people's mean looks per dimension less
+    ///   the part their own looks' noise explains (s_w² times the mean of 1/looks);
+    /// - C₀ = c·I with c such that a kernel seen once predicts the person's next look with the
+    ///   spread of the difference of two looks: its Student-t scale ψ₁(λ₁ + 1)/(λ₁·ν), λ₁ =
+    ///   1/κ₀ + 1 and ν = η₀ − r + 2, equal to 2·s_w² along every direction the one look does
+    ///   not fix, i.e. c = 2·s_w²·λ₁·ν/(λ₁ + 1).
+    ///
+    /// `None` without two looks of one person or two people, or with looks of another
+    /// dimension.
+    pub fn moved(&self, people: &[Vec<Vec<f64>>]) -> Option<Moved> {
+        let r = self.a0.len();
+        let all: Vec<&Vec<f64>> = people.iter().flatten().collect();
+        if all.is_empty() || all.iter().any(|o| o.len() != r) || people.len() < 2 {
+            return None;
+        }
+        let mean_of = |looks: &[&Vec<f64>]| -> Vec<f64> {
+            (0..r)
+                .map(|j| looks.iter().map(|o| o[j]).sum::<f64>() / looks.len() as f64)
+                .collect()
+        };
+        let a0 = mean_of(&all);
+        let means: Vec<Vec<f64>> = people
+            .iter()
+            .filter(|l| !l.is_empty())
+            .map(|l| mean_of(&l.iter().collect::<Vec<_>>()))
+            .collect();
+        let (mut sum, mut dof) = (0.0, 0usize);
+        for (looks, m) in people.iter().filter(|l| !l.is_empty()).zip(&means) {
+            for j in 0..r {
+                sum += looks.iter().map(|o| (o[j] - m[j]).powi(2)).sum::<f64>();
+            }
+            dof += looks.len() - 1;
+        }
+        if dof == 0 || means.len() < 2 {
+            return None;
+        }
+        let within_var = sum / (dof * r) as f64;
+        let centre = mean_of(&means.iter().collect::<Vec<_>>());
+        let spread: f64 = means
+            .iter()
+            .map(|m| (0..r).map(|j| (m[j] - centre[j]).powi(2)).sum::<f64>())
+            .sum::<f64>()
+            / (r * (means.len() - 1)) as f64;
+        let noise = within_var
+            * people
+                .iter()
+                .filter(|l| !l.is_empty())
+                .map(|l| 1.0 / l.len() as f64)
+                .sum::<f64>()
+            / means.len() as f64;
+        let between_var = (spread - noise).max(0.0);
+        let kappa0 = (between_var / within_var).max(KAPPA0_MIN);
+        let (lambda1, nu) = (1.0 / kappa0 + 1.0, self.eta0 - r as f64 + 2.0);
+        Some(Moved {
+            prior: Prior {
+                a0,
+                kappa0,
+                eta0: self.eta0,
+                c0: 2.0 * within_var * lambda1 * nu / (lambda1 + 1.0),
+            },
+            within_sd: within_var.sqrt(),
+            between_sd: between_var.sqrt(),
+            observations: all.len(),
+            people: means.len(),
+        })
+    }
+
     pub fn niw(&self) -> Niw {
         let r = self.a0.len();
         Niw {
@@ -78,6 +151,22 @@ impl Prior {
             psi: DMatrix::identity(r, r) * self.c0,
         }
     }
+}
+
+/// The smallest κ₀ a moved prior takes: people's means spread at least as much as one
+/// person's looks (a priori: with less, appearance could not tell people apart at all).
+pub const KAPPA0_MIN: f64 = 1.0;
+
+/// A prior moved to the features' units ([`Prior::moved`]) and what it was fitted on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Moved {
+    pub prior: Prior,
+    /// s_w, the pooled within-person standard deviation per dimension.
+    pub within_sd: f64,
+    /// s_b, the standard deviation of the people's means per dimension (noise removed).
+    pub between_sd: f64,
+    pub observations: usize,
+    pub people: usize,
 }
 
 /// Why a kernel cannot be used.

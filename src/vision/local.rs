@@ -387,6 +387,20 @@ impl LocalTracker {
     pub fn mask(&self) -> &[u8] {
         &self.mask
     }
+    /// The foreground the blobs of the last frame were cut from (the GMM mask without
+    /// shadows, majority-filtered when `majority_filter` is on; [`FOREGROUND`] = a moving
+    /// pixel, 0 = not), or `None` on a frame that took no blobs (the camera moving, or the
+    /// warm-up after a restart): the pixels a robot knows to belong to people.
+    pub fn foreground(&self) -> Option<&[u8]> {
+        if self.moving || self.since_reset <= self.params.warmup_frames || self.mask.is_empty() {
+            return None;
+        }
+        Some(if self.params.majority_filter {
+            &self.filtered
+        } else {
+            &self.mask
+        })
+    }
     /// Blob labels of the last frame (0 = none), as named by [`Observation::blobs`].
     pub fn labels(&self) -> &[u32] {
         &self.labels

@@ -349,6 +349,7 @@ mod tests {
                 rgb: &rgb,
                 view: ImageView::rgb(&rgb).expect("view"),
                 mask: Some(&mask),
+                person_ids: None,
                 truth: Some(&truth),
                 moving: false,
             };
@@ -378,6 +379,7 @@ mod tests {
             rgb: &rgb,
             view: ImageView::rgb(&rgb).expect("view"),
             mask: Some(&mask),
+            person_ids: None,
             truth: Some(&twins),
             moving: false,
         };

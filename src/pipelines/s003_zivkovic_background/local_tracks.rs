@@ -150,6 +150,11 @@ impl LocalRun {
         Ok(())
     }
 
+    /// The tracker's foreground of the latest frame stepped (`None`: it took no blobs).
+    pub fn foreground(&self) -> Option<&[u8]> {
+        self.tracker.foreground()
+    }
+
     /// The tracks' boxes of frame `frame` (the latest frame stepped).
     pub fn frame_tracks(&self, frame: i64) -> &[TrackRow] {
         let first = self

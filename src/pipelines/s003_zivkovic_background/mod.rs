@@ -22,6 +22,13 @@
 //! - **Local tracks** ([`LocalTracker`]) on every session, the camera taken as moving when
 //!   odometry reports a speed or turn rate above the thresholds; scored against the ground
 //!   truth boxes with CLEAR MOT and IDF1 (IoU ≥ `local_eval.min_iou`).
+//! - **Re-identification** (Zajdel et al., inside seed 003, §IV–V) on `reid.datasets` and
+//!   the training split `reid.train_datasets`: the region means of every ground-truth and
+//!   local-track box per frame, of the tracker's foreground, the exact per-person mask and
+//!   the whole box (`reid`); at aggregation local tracks become observations
+//!   (`reid_features`), the methods (`reid_methods`) label them clip by clip, and the runs
+//!   are scored per session (`reid_report`) and across sessions (`reid_summary`), with
+//!   figs. 4b, 5 and 6 (`reid_figures`, `reid_snapshots`).
 //!
 //! Aggregation writes the ROC table, figures and summary (TP at fixed FP), the timing table
 //! (measured, so *not* byte-identical between runs: kept apart), the components images, the
@@ -34,7 +41,9 @@
 //! [`shared::Frame`] to one state struct per sub-experiment, and the `sessions` table),
 //! `shared` (the frame, the `session` row, grouping by dataset), one file per sub-experiment holding
 //! its per-frame state, cached tables, result tables and figures (`roc` + `roc_report`, `timing`,
-//! `components`, `colour` + `colour_report`, `local_tracks`, `wallflower`).
+//! `components`, `colour` + `colour_report`, `local_tracks`, `moving`, `reid` with
+//! `reid_params`, `reid_features`, `reid_methods`, `reid_report`, `reid_summary`,
+//! `reid_figures` and `reid_snapshots` (+ `snapshots`), `wallflower`).
 
 mod colour;
 mod colour_report;
@@ -43,9 +52,13 @@ mod local_tracks;
 mod moving;
 mod params;
 mod reid;
+mod reid_features;
 mod reid_figures;
+mod reid_methods;
+mod reid_params;
 mod reid_report;
 mod reid_snapshots;
+mod reid_summary;
 mod roc;
 mod roc_report;
 mod session;
@@ -73,7 +86,9 @@ impl Experiment for BackgroundTracking {
     // 3: timing = fastest of 3 runs per frame; standing/walking person pixels; cached tables
     //    from row structs, images as PNG
     // 5: re-identification features (`reid_frames`) for `reid.datasets`
-    const VERSION: u32 = 5;
+    // 6: `reid_frames` per box and pixel set (tracker foreground, exact id mask, box), raw
+    //    region means and frame means; `reid.train_datasets` too
+    const VERSION: u32 = 6;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {
@@ -102,6 +117,11 @@ impl Experiment for BackgroundTracking {
                 requires: vec![tp.image.clone()],
                 optional: vec![tp.ground_truth.clone(), tp.odom.clone()],
             },
+            Stage {
+                name: "re-identification features".into(),
+                requires: vec![tp.image.clone()],
+                optional: vec![tp.ground_truth.clone(), tp.person_ids.clone()],
+            },
         ]
     }
 
@@ -127,7 +147,9 @@ impl Experiment for BackgroundTracking {
         colour_report::products(ctx, p, &mut products)?;
         local_tracks::products(ctx, p, &mut products)?;
         moving::products(ctx, p, &mut products)?;
-        reid_report::products(ctx, p, &mut products)?;
+        if let Some((runs, training)) = reid_report::products(ctx, p, &mut products)? {
+            reid_summary::products(&runs, &training, &p.reid, &mut products)?;
+        }
         reid_figures::products(ctx, &p.reid, &mut products)?;
         reid_snapshots::products(ctx, &p.reid, &mut products)?;
         wallflower::products(p, &mut products)?;

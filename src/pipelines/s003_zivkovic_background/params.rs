@@ -14,6 +14,9 @@ use crate::vision::local::{LocalError, LocalParams};
 use crate::vision::moving::MovingParams;
 use crate::vision::sg1999::Sg1999Params;
 
+use super::reid_params::validate_reid;
+pub use super::reid_params::{ClipParams, ReidParams};
+
 /// `[params.roc]`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -236,63 +239,6 @@ impl Default for WallflowerParams {
     }
 }
 
-/// One clip of `[params.reid]`: the observations that ended by `until_s` (seconds since the
-/// session's first frame; absent: the whole session), as the paper's clips cover one or more
-/// places of the tour.
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct ClipParams {
-    pub name: String,
-    #[serde(default)]
-    pub until_s: Option<f64>,
-}
-
-/// `[params.reid]`: re-identification across local tracks (Zajdel et al., ICRA 2005).
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct ReidParams {
-    /// Datasets whose sessions are re-identified (a touring robot with several people).
-    pub datasets: Vec<String>,
-    /// Ground-truth boxes less visible than this are left out of the features.
-    pub min_visibility: f64,
-    /// A local track breaks where its person or track is unseen for longer than this (s).
-    pub max_gap_s: f64,
-    /// Local tracks with fewer frames than this are no observation.
-    pub min_frames: usize,
-    /// The nearest-neighbour baseline's distance threshold on the normalised 9-D feature.
-    pub nn_threshold: f64,
-    pub clips: Vec<ClipParams>,
-    /// Confidence level of the t-tests.
-    pub level: f64,
-    /// Figs. 5–6: the session keeps the frame with the most people of every window this long
-    /// (s); the figures draw four of them per clip.
-    pub snapshot_window_s: f64,
-}
-
-impl Default for ReidParams {
-    fn default() -> Self {
-        Self {
-            datasets: vec!["home_tour".into()],
-            min_visibility: 0.5,
-            max_gap_s: 1.0,
-            min_frames: 5,
-            nn_threshold: 0.15,
-            clips: vec![
-                ClipParams {
-                    name: "similar light".into(),
-                    until_s: Some(95.0),
-                },
-                ClipParams {
-                    name: "across light".into(),
-                    until_s: None,
-                },
-            ],
-            level: 0.95,
-            snapshot_window_s: 5.0,
-        }
-    }
-}
-
 /// `[params.moving]`: the moving-camera detection of Zajdel et al. §III-B (KLT corners, a
 /// RANSAC fundamental matrix, the outliers as moving people), scored on the frames where the
 /// camera moves. See `vision::moving` for what each value means.
@@ -379,7 +325,7 @@ fn topic(topics: &BTreeMap<String, String>, logical: &str, default: String) -> S
 }
 
 /// The logical topic names `[topics]` may remap.
-pub(super) const TOPIC_KEYS: [&str; 4] = ["image", "mask", "ground_truth", "odom"];
+pub(super) const TOPIC_KEYS: [&str; 5] = ["image", "mask", "ground_truth", "odom", "person_ids"];
 
 /// The topics read, with `[topics]` remaps applied.
 pub(super) struct Topics {
@@ -387,6 +333,8 @@ pub(super) struct Topics {
     pub mask: String,
     pub ground_truth: String,
     pub odom: String,
+    /// The per-person id mask (`mono8`, each pixel the id of the person seen there).
+    pub person_ids: String,
 }
 
 pub(super) fn topics_of(p: &Params, t: &BTreeMap<String, String>) -> Topics {
@@ -395,6 +343,7 @@ pub(super) fn topics_of(p: &Params, t: &BTreeMap<String, String>) -> Topics {
         mask: topic(t, "mask", format!("/{}/ground_truth_mask", p.camera)),
         ground_truth: topic(t, "ground_truth", PEOPLE_TOPIC.to_string()),
         odom: topic(t, "odom", "/odom".to_string()),
+        person_ids: topic(t, "person_ids", format!("/{}/ground_truth_ids", p.camera)),
     }
 }
 
@@ -428,43 +377,6 @@ fn local_problem(e: &LocalError) -> Invalid {
         LocalError::Gmm(g) => gmm_problem("local.gmm", g),
         LocalError::Colour(c) => colour_problem("local.em", c),
         other => ("local".into(), other.to_string()),
-    }
-}
-
-/// Every parameter problem, named by its key path below `[params]`.
-fn validate_reid(r: &ReidParams, bad: &mut impl FnMut(&str, String)) {
-    if !(0.0..=1.0).contains(&r.min_visibility) {
-        bad(
-            "reid.min_visibility",
-            format!("{} is not in [0, 1]", r.min_visibility),
-        );
-    }
-    for (key, v) in [
-        ("reid.max_gap_s", r.max_gap_s),
-        ("reid.nn_threshold", r.nn_threshold),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            bad(key, format!("{v} must be finite and positive"));
-        }
-    }
-    if r.min_frames == 0 {
-        bad("reid.min_frames", "must be at least 1".into());
-    }
-    if !(r.level > 0.0 && r.level < 1.0) {
-        bad("reid.level", format!("{} is not in (0, 1)", r.level));
-    }
-    if r.clips.is_empty() {
-        bad("reid.clips", "needs at least one clip".into());
-    }
-    for (i, c) in r.clips.iter().enumerate() {
-        if let Some(t) = c.until_s
-            && !(t.is_finite() && t > 0.0)
-        {
-            bad(
-                &format!("reid.clips[{i}].until_s"),
-                format!("{t} must be finite and > 0"),
-            );
-        }
     }
 }
 
@@ -681,6 +593,7 @@ mod tests {
         let t = topics_of(&p, &BTreeMap::new());
         assert_eq!(t.image, "/cam_0/image_raw/compressed");
         assert_eq!(t.mask, "/cam_0/ground_truth_mask");
+        assert_eq!(t.person_ids, "/cam_0/ground_truth_ids");
         let remap = BTreeMap::from([("odom".to_string(), "/robot/odom".to_string())]);
         assert_eq!(topics_of(&p, &remap).odom, "/robot/odom");
     }

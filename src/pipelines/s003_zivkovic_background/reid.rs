@@ -1,20 +1,32 @@
-//! Re-identification, the session stage (seed 003 §IV–V, Zajdel et al.): the paper's 9-D
-//! appearance feature of every person box in every frame, for the ground-truth boxes (local
-//! tracks given, which isolates re-identification) and for the system's own local tracks
-//! (the whole chain), cached per frame as the `reid_frames` table. `reid_report` groups them
-//! into local tracks and runs the filter.
+//! Re-identification, the session stage (seed 003 §IV–V, Zajdel et al.): the mean colours of
+//! the three regions of fig. 4a for every person box in every frame — the ground-truth boxes
+//! (local tracks given, which isolates re-identification) and the system's own local tracks
+//! (the whole chain) — cached per frame as the `reid_frames` table, one row per box and pixel
+//! set. `reid_report` turns them into the paper's colour space, groups them into local tracks
+//! and runs the filter.
 //!
-//! The feature (paper fig. 4a): three horizontal regions of 25 % of the box height, with
-//! "skip areas" of 12.5 %; the mean colour of each region. The text does not say where the
-//! two skip areas lie; here they are the top (head) and the bottom (feet) of the box — the
-//! parts with the least discriminative power — so the regions cover 12.5–37.5 %, 37.5–62.5 %
-//! and 62.5–87.5 % of the height. The colour-channel-normalised space of the paper's [8] is
-//! read as grey-world normalisation: each channel divided by its mean over the frame, which
-//! cancels a change of illuminant per channel. The log of that ratio is the feature: the
-//! paper's prior centres the kernels' means at a₀ = 0 with a spread of about 0.1 (κ₀ = 100,
-//! C₀ = 10⁻³·I), which fits a space where the frame's average colour is 0 and a change of
-//! light a shift, not ratios around 1. The raw variant (RGB / 255) is kept for the "without
-//! colour normalisation" baseline.
+//! **Whose pixels.** §III: "We need to know which pixels belong to a person in order to give
+//! an accurate description on its appearance." Three pixel sets per box:
+//! - `person` (the default): the local tracker's own foreground (`LocalTracker::foreground`:
+//!   the GMM mask without shadows, majority-filtered) inside the box — what a robot has. None
+//!   while the camera moves or the model warms up after a restart.
+//! - `exact` (the ceiling): the synthesizer's per-person id mask (`/cam_0/ground_truth_ids`,
+//!   when the log has it) — the box's person's own pixels; for a system track, those of the
+//!   person it overlaps most.
+//! - `box`: every pixel of the box, background included (the feature before issue 31, kept
+//!   to measure what the person's pixels change).
+//!
+//! **The regions** (fig. 4a): three horizontal regions of 25 % of "the blob's height" with
+//! "skip areas" of 12.5 %. For the mask sets the blob is the set's pixels inside the box and
+//! its height their extent from the first to the last row holding one; for `box` it is the
+//! box. The text does not say where the two skip areas lie; here they are the top (head) and
+//! the bottom (feet) — the parts with the least discriminative power — so the regions cover
+//! 12.5–37.5 %, 37.5–62.5 % and 62.5–87.5 % of the height. A mask region with fewer than
+//! [`MIN_REGION_PX`] pixels gives no row for that frame (counted at the report).
+//!
+//! The row keeps the raw means (0–255) and the frame's channel means, so that the report can
+//! form any colour space: the paper's colour-channel-normalised one ([8], Drew, Wei & Li: each
+//! channel divided by its mean over the image), its logarithm, raw RGB.
 
 use image::RgbImage;
 
@@ -26,15 +38,26 @@ use crate::geometry::rect;
 use crate::report::rows::Rows;
 use crate::run::SessionTables;
 use crate::table_row;
+use crate::vision::gmm::FOREGROUND;
 
 /// Name of the cached per-frame feature table.
 pub(super) const FRAMES_TABLE: &str = "reid_frames";
 
-/// The region bounds as fractions of the box height, top to bottom.
+/// The region bounds as fractions of the blob's height, top to bottom.
 pub(super) const REGIONS: [(f64, f64); 3] = [(0.125, 0.375), (0.375, 0.625), (0.625, 0.875)];
 
+/// A region of a mask pixel set needs this many pixels for its mean colour (a priori: the
+/// mean of 10 pixels carries the camera noise of σ ≈ 2.5 grey levels as < 1 level; fewer is
+/// a sliver of a person or a few stray foreground pixels).
+pub(super) const MIN_REGION_PX: u64 = 10;
+
+/// The pixel sets (`pixels` column): the tracker's foreground, the exact person mask, the box.
+pub(super) const PERSON: &str = "person";
+pub(super) const EXACT: &str = "exact";
+pub(super) const BOX: &str = "box";
+
 table_row! {
-    /// Cached per session: one box's features in one frame.
+    /// Cached per session: the region means of one box's pixel set in one frame.
     #[derive(Debug, Clone, PartialEq)]
     pub(super) struct ReidFrameRow {
         pub frame: i64,
@@ -45,17 +68,23 @@ table_row! {
         pub id: i64,
         /// The ground-truth person a system box overlaps most (IoU ≥ `local_eval.min_iou`).
         pub truth_id: Option<i64>,
-        /// The 9-D feature, ln of the grey-world ratio: region 1 r, g, b, region 2 r, g, b, …
-        pub f1: f64, pub f2: f64, pub f3: f64, pub f4: f64, pub f5: f64,
-        pub f6: f64, pub f7: f64, pub f8: f64, pub f9: f64,
-        /// The same regions, raw RGB / 255.
-        pub r1: f64, pub r2: f64, pub r3: f64, pub r4: f64, pub r5: f64,
-        pub r6: f64, pub r7: f64, pub r8: f64, pub r9: f64,
+        /// `person`, `exact` or `box` (the module doc).
+        pub pixels: String,
+        /// Pixels of the set inside the box.
+        pub px: i64,
+        /// The frame's mean of each channel (0–255, never below 1).
+        pub mean_r: f64, pub mean_g: f64, pub mean_b: f64,
+        /// Region means, raw 0–255: region 1 r, g, b, region 2 r, g, b, region 3 r, g, b.
+        pub m1: f64, pub m2: f64, pub m3: f64, pub m4: f64, pub m5: f64,
+        pub m6: f64, pub m7: f64, pub m8: f64, pub m9: f64,
     }
 }
 
+/// Who a box is and what it shows: `(frame, t_s, source, id, truth_id)`.
+pub(super) type Head<'a> = (i64, f64, &'a str, i64, Option<i64>);
+
 impl ReidFrameRow {
-    pub(super) fn new(head: (i64, f64, &str, i64, Option<i64>), f: [f64; 9], r: [f64; 9]) -> Self {
+    pub(super) fn new(head: Head, pixels: &str, px: u64, means: [f64; 3], m: [f64; 9]) -> Self {
         let (frame, t_s, source, id, truth_id) = head;
         ReidFrameRow {
             frame,
@@ -63,43 +92,38 @@ impl ReidFrameRow {
             source: source.to_string(),
             id,
             truth_id,
-            f1: f[0],
-            f2: f[1],
-            f3: f[2],
-            f4: f[3],
-            f5: f[4],
-            f6: f[5],
-            f7: f[6],
-            f8: f[7],
-            f9: f[8],
-            r1: r[0],
-            r2: r[1],
-            r3: r[2],
-            r4: r[3],
-            r5: r[4],
-            r6: r[5],
-            r7: r[6],
-            r8: r[7],
-            r9: r[8],
+            pixels: pixels.to_string(),
+            px: px as i64,
+            mean_r: means[0],
+            mean_g: means[1],
+            mean_b: means[2],
+            m1: m[0],
+            m2: m[1],
+            m3: m[2],
+            m4: m[3],
+            m5: m[4],
+            m6: m[5],
+            m7: m[6],
+            m8: m[7],
+            m9: m[8],
         }
     }
 
-    /// The normalised (`raw = false`) or raw feature.
-    pub fn feature(&self, raw: bool) -> [f64; 9] {
-        if raw {
-            [
-                self.r1, self.r2, self.r3, self.r4, self.r5, self.r6, self.r7, self.r8, self.r9,
-            ]
-        } else {
-            [
-                self.f1, self.f2, self.f3, self.f4, self.f5, self.f6, self.f7, self.f8, self.f9,
-            ]
-        }
+    /// The raw region means (0–255).
+    pub fn means(&self) -> [f64; 9] {
+        [
+            self.m1, self.m2, self.m3, self.m4, self.m5, self.m6, self.m7, self.m8, self.m9,
+        ]
+    }
+
+    /// The frame's channel means.
+    pub fn frame_means(&self) -> [f64; 3] {
+        [self.mean_r, self.mean_g, self.mean_b]
     }
 }
 
-/// Mean of each channel over the frame (grey world), never below 1 grey level.
-fn channel_means(rgb: &RgbImage) -> [f64; 3] {
+/// Mean of each channel over the frame, never below 1 grey level.
+pub(super) fn channel_means(rgb: &RgbImage) -> [f64; 3] {
     let mut sum = [0u64; 3];
     for p in rgb.pixels() {
         for (acc, v) in sum.iter_mut().zip(p.0) {
@@ -110,23 +134,72 @@ fn channel_means(rgb: &RgbImage) -> [f64; 3] {
     sum.map(|s| (s as f64 / n).max(1.0))
 }
 
-/// The three regions' mean RGB inside box `[x0, y0, x1, y1)` (pixels, clipped to the image),
-/// raw 0..255; `None` when a region holds no pixel.
-pub(super) fn region_means(rgb: &RgbImage, b: [f64; 4]) -> Option<[f64; 9]> {
-    let (w, h) = (f64::from(rgb.width()), f64::from(rgb.height()));
-    let x0 = b[0].max(0.0).floor() as u32;
-    let x1 = b[2].min(w).ceil() as u32;
-    if !(b.iter().all(|v| v.is_finite())) || x1 <= x0 || b[3] <= b[1] {
+/// Which pixels of a box count.
+#[derive(Clone, Copy)]
+pub(super) enum Pixels<'a> {
+    /// Every pixel; the regions split the box's height.
+    All,
+    /// Pixels where the row-major `mask` (the image's size) equals `value`; the regions split
+    /// the height of those pixels' extent.
+    Where { mask: &'a [u8], value: u8 },
+}
+
+/// Rows `[y0, y1)` of the three regions of a blob spanning rows `top..bottom` (fractional for
+/// a box), clipped to `height`.
+fn region_rows(top: f64, bottom: f64, height: f64) -> [(u32, u32); 3] {
+    REGIONS.map(|(a, b)| {
+        let y0 = (top + a * (bottom - top)).max(0.0).round() as u32;
+        let y1 = (top + b * (bottom - top)).min(height).round() as u32;
+        (y0, y1)
+    })
+}
+
+/// The three regions' mean RGB (raw 0..255) of the `pixels` inside box `[x0, y0, x1, y1)`
+/// (clipped to the image), with the number of pixels of the set in the box; `None` when a
+/// region holds no pixel (`All`) or fewer than [`MIN_REGION_PX`] (a mask).
+pub(super) fn region_means(rgb: &RgbImage, b: [f64; 4], pixels: Pixels) -> Option<([f64; 9], u64)> {
+    let (w, h) = (rgb.width(), rgb.height());
+    if !(b.iter().all(|v| v.is_finite())) || b[3] <= b[1] {
         return None;
     }
+    let x0 = b[0].max(0.0).floor() as u32;
+    let x1 = b[2].min(f64::from(w)).ceil() as u32;
+    if x1 <= x0 {
+        return None;
+    }
+    let selected = |x: u32, y: u32| match pixels {
+        Pixels::All => true,
+        Pixels::Where { mask, value } => {
+            mask.get(y as usize * w as usize + x as usize) == Some(&value)
+        }
+    };
+    let (rows, least, in_box) = match pixels {
+        Pixels::All => (region_rows(b[1], b[3], f64::from(h)), 1, 0),
+        Pixels::Where { .. } => {
+            let ys = (b[1].max(0.0).floor() as u32)..(b[3].min(f64::from(h)).ceil() as u32);
+            let (mut top, mut bottom, mut n) = (u32::MAX, 0u32, 0u64);
+            for y in ys {
+                let k = (x0..x1).filter(|&x| selected(x, y)).count() as u64;
+                if k > 0 {
+                    top = top.min(y);
+                    bottom = y + 1;
+                    n += k;
+                }
+            }
+            if n == 0 {
+                return None;
+            }
+            let rows = region_rows(f64::from(top), f64::from(bottom), f64::from(h));
+            (rows, MIN_REGION_PX, n)
+        }
+    };
     let mut out = [0.0; 9];
-    for (r, (top, bottom)) in REGIONS.iter().enumerate() {
-        let y0 = (b[1] + top * (b[3] - b[1])).max(0.0).round() as u32;
-        let y1 = (b[1] + bottom * (b[3] - b[1])).min(h).round() as u32;
+    let mut total = 0u64;
+    for (r, (y0, y1)) in rows.iter().enumerate() {
         let mut sum = [0u64; 3];
         let mut n = 0u64;
-        for y in y0..y1 {
-            for x in x0..x1 {
+        for y in *y0..*y1 {
+            for x in (x0..x1).filter(|&x| selected(x, y)) {
                 let p = rgb.get_pixel(x, y).0;
                 for c in 0..3 {
                     sum[c] += u64::from(p[c]);
@@ -134,19 +207,22 @@ pub(super) fn region_means(rgb: &RgbImage, b: [f64; 4]) -> Option<[f64; 9]> {
                 n += 1;
             }
         }
-        if n == 0 {
+        if n < least {
             return None;
         }
+        total += n;
         for c in 0..3 {
             out[3 * r + c] = sum[c] as f64 / n as f64;
         }
     }
-    Some(out)
+    Some((out, if in_box > 0 { in_box } else { total }))
 }
 
 /// The re-identification features of one session.
 pub(super) struct ReidRun {
     wanted: bool,
+    /// Figs. 5–6 frames are kept (scored datasets only, not the training split).
+    keep_snapshots: bool,
     camera: String,
     min_visibility: f64,
     min_iou: f64,
@@ -155,10 +231,12 @@ pub(super) struct ReidRun {
 }
 
 impl ReidRun {
-    /// Features are computed only for the datasets `reid.datasets` names.
+    /// Features are computed for the datasets `reid.datasets` and `reid.train_datasets` name.
     pub fn new(p: &Params, dataset: &str) -> Self {
+        let scored = p.reid.datasets.iter().any(|d| d == dataset);
         Self {
-            wanted: p.reid.datasets.iter().any(|d| d == dataset),
+            wanted: scored || p.reid.train_datasets.iter().any(|d| d == dataset),
+            keep_snapshots: scored,
             camera: p.camera.clone(),
             min_visibility: p.reid.min_visibility,
             min_iou: p.local_eval.min_iou,
@@ -167,8 +245,14 @@ impl ReidRun {
         }
     }
 
-    /// Features of the frame's ground-truth boxes and of the local tracks' boxes `tracks`.
-    pub fn step(&mut self, f: &Frame, tracks: &[TrackRow]) {
+    /// Whether this session is re-identified (its frames need the person-id mask, if any).
+    pub fn wanted(&self) -> bool {
+        self.wanted
+    }
+
+    /// Features of the frame's ground-truth boxes and of the local tracks' boxes `tracks`,
+    /// with the tracker's `foreground` of this frame (`None`: no blobs were taken).
+    pub fn step(&mut self, f: &Frame, tracks: &[TrackRow], foreground: Option<&[u8]>) {
         if !self.wanted {
             return;
         }
@@ -186,7 +270,7 @@ impl ReidRun {
         }
         let mut shown: Vec<(&str, i64, [f64; 4])> = Vec::new();
         for &(id, b) in &truth_boxes {
-            self.push(f, "truth", id, None, b, means);
+            self.push(f, (f.index, f.t_s, "truth", id, None), b, means, foreground);
             shown.push(("truth", id, b));
         }
         for t in tracks {
@@ -197,34 +281,55 @@ impl ReidRun {
                 .filter(|(_, o)| *o >= self.min_iou)
                 .max_by(|a, b| a.1.total_cmp(&b.1))
                 .map(|(id, _)| id);
-            self.push(f, "system", t.track, truth_id, b, means);
+            let head = (f.index, f.t_s, "system", t.track, truth_id);
+            self.push(f, head, b, means, foreground);
             shown.push(("system", t.track, b));
         }
-        self.snapshots.offer(f.index, f.t_s, f.rgb, &shown);
+        if self.keep_snapshots {
+            self.snapshots.offer(f.index, f.t_s, f.rgb, &shown);
+        }
     }
 
+    /// One box's rows: every pixel set that gives a feature in this frame.
     fn push(
         &mut self,
         f: &Frame,
-        source: &str,
-        id: i64,
-        truth_id: Option<i64>,
+        head: Head,
         b: [f64; 4],
         means: [f64; 3],
+        foreground: Option<&[u8]>,
     ) {
-        if let Some(raw) = region_means(f.rgb, b) {
-            self.rows.push(ReidFrameRow::new(
-                (f.index, f.t_s, source, id, truth_id),
-                std::array::from_fn(|i| (raw[i].max(1.0) / means[i % 3]).ln()),
-                raw.map(|v| v / 255.0),
-            ));
+        // the person whose exact pixels count: the box's own, or the one a track overlaps
+        let person = if head.2 == "truth" {
+            Some(head.3)
+        } else {
+            head.4
+        };
+        let exact = f.person_ids.zip(person).map(|(mask, id)| Pixels::Where {
+            mask,
+            value: u8::try_from(id).unwrap_or(u8::MAX),
+        });
+        let person_px = foreground.map(|mask| Pixels::Where {
+            mask,
+            value: FOREGROUND,
+        });
+        for (name, pixels) in [
+            (BOX, Some(Pixels::All)),
+            (PERSON, person_px),
+            (EXACT, exact),
+        ] {
+            if let Some((m, px)) = pixels.and_then(|p| region_means(f.rgb, b, p)) {
+                self.rows.push(ReidFrameRow::new(head, name, px, means, m));
+            }
         }
     }
 
-    /// The cached `reid_frames` table (only for the wanted datasets).
+    /// The cached `reid_frames` table (only for the wanted datasets), and figs. 5–6 frames.
     pub fn finish(self, out: &mut SessionTables) -> anyhow::Result<()> {
         if self.wanted {
             out.insert(FRAMES_TABLE.into(), ReidFrameRow::frame(&self.rows)?);
+        }
+        if self.keep_snapshots {
             self.snapshots.finish(out)?;
         }
         Ok(())
@@ -245,13 +350,71 @@ mod tests {
                 image::Rgb([0, 0, 100])
             }
         });
-        let m = region_means(&img, [0.0, 0.0, 8.0, 16.0]).expect("regions");
+        let (m, px) = region_means(&img, [0.0, 0.0, 8.0, 16.0], Pixels::All).expect("regions");
         // region 1: rows 2..6 (red); region 2: rows 6..10 (half red, half blue); region 3:
         // rows 10..14 (blue)
         assert_eq!(m, [200.0, 0.0, 0.0, 100.0, 0.0, 50.0, 0.0, 0.0, 100.0]);
-        // grey world: the red channel's frame mean is 100, blue's 50 (green 0 → 1)
+        assert_eq!(px, 96, "the regions' pixels");
+        // the channel normalisation's means: red 100, blue 50, green 0 → 1
         assert_eq!(channel_means(&img), [100.0, 1.0, 50.0]);
-        assert_eq!(region_means(&img, [4.0, 4.0, 4.0, 10.0]), None, "empty box");
-        assert_eq!(region_means(&img, [0.0, f64::NAN, 8.0, 16.0]), None);
+        let all = Pixels::All;
+        assert_eq!(
+            region_means(&img, [4.0, 4.0, 4.0, 10.0], all),
+            None,
+            "empty box"
+        );
+        assert_eq!(region_means(&img, [0.0, f64::NAN, 8.0, 16.0], all), None);
+    }
+
+    #[test]
+    fn a_masks_regions_split_the_blobs_own_height_and_average_only_its_pixels() {
+        // a 10 × 20 grey background; the "person" (mask 7) covers columns 2..6, rows 4..20:
+        // green rows 4..12, blue rows 12..20. The box is wider and taller than the person.
+        let person = |x: u32, y: u32| (2..6).contains(&x) && y >= 4;
+        let img = RgbImage::from_fn(10, 20, |x, y| match (person(x, y), y < 12) {
+            (false, _) => image::Rgb([120, 120, 120]),
+            (true, true) => image::Rgb([0, 200, 0]),
+            (true, false) => image::Rgb([0, 0, 220]),
+        });
+        let mask: Vec<u8> = (0..200u32)
+            .map(|i| if person(i % 10, i / 10) { 7 } else { 0 })
+            .collect();
+        let pixels = Pixels::Where {
+            mask: &mask,
+            value: 7,
+        };
+        let b = [0.0, 0.0, 10.0, 20.0];
+        let (m, px) = region_means(&img, b, pixels).expect("regions");
+        // the blob spans rows 4..20 (16 rows): regions rows 6..10 (green), 10..14 (half and
+        // half), 14..18 (blue); no background pixel counts
+        assert_eq!(m, [0.0, 200.0, 0.0, 0.0, 100.0, 110.0, 0.0, 0.0, 220.0]);
+        assert_eq!(px, 64, "the person's pixels in the box");
+        // the whole box instead: regions on rows 2.5..7.5 etc., background included
+        let (all, _) = region_means(&img, b, Pixels::All).expect("box");
+        assert!(
+            all[1] < 200.0 && all[0] > 0.0,
+            "background dilutes: {all:?}"
+        );
+        // a region with fewer than MIN_REGION_PX pixels gives nothing: a 2-column person
+        let thin: Vec<u8> = (0..200u32)
+            .map(|i| {
+                if (2..4).contains(&(i % 10)) && i / 10 >= 16 {
+                    7
+                } else {
+                    0
+                }
+            })
+            .collect();
+        let thin = Pixels::Where {
+            mask: &thin,
+            value: 7,
+        };
+        assert_eq!(region_means(&img, b, thin), None);
+        // another value of the mask is nobody here
+        let other = Pixels::Where {
+            mask: &mask,
+            value: 3,
+        };
+        assert_eq!(region_means(&img, b, other), None);
     }
 }

@@ -1,10 +1,12 @@
-//! Re-identification figures for the first re-identified session: the identity timeline per
-//! person (truth vs the paper's model, on ground-truth local tracks, the longest clip) and the
-//! paper's fig. 4b (the first three feature components of one local track over its frames).
+//! Re-identification figures for the first scored session: the identity timeline per person
+//! (truth vs the paper's model, on ground-truth local tracks, the whole session) and the
+//! paper's fig. 4b (the first three feature components of one local track over its frames:
+//! the top region's channel-normalised r, g, b of the person's pixels).
 
 use super::params::ReidParams;
-use super::reid::{FRAMES_TABLE, ReidFrameRow};
-use super::reid_report::{Method, Observation, labels, observations};
+use super::reid::{FRAMES_TABLE, PERSON, ReidFrameRow};
+use super::reid_features::{Observation, Space, observations};
+use super::reid_methods::{PAPER, Training, labels};
 use crate::report::Figure;
 use crate::report::figure::{FigureKind, LinePlot, Mark, Panels, Series};
 use crate::report::rows::Rows;
@@ -71,6 +73,7 @@ fn features_over_time(rows: &[ReidFrameRow], obs: &Observation, session: &str) -
         .iter()
         .filter(|r| {
             r.source == "truth"
+                && r.pixels == PERSON
                 && r.id == obs.id
                 && r.t_s >= obs.span.enter
                 && r.t_s <= obs.span.leave
@@ -82,7 +85,7 @@ fn features_over_time(rows: &[ReidFrameRow], obs: &Observation, session: &str) -
         .map(|(c, name)| {
             let pts = frames
                 .iter()
-                .map(|r| (r.t_s, r.feature(false)[c]))
+                .map(|r| (r.t_s, Space::Normalised.of(r.means(), r.frame_means())[c]))
                 .collect();
             Series::line(format!("region 1 {name}"), pts, c)
         })
@@ -90,12 +93,12 @@ fn features_over_time(rows: &[ReidFrameRow], obs: &Observation, session: &str) -
     Figure::new(
         "reid_features_fig4b",
         format!(
-            "Fig. 4b: top-region r, g, b over one track ({session}, person {})",
+            "Fig. 4b: top-region r, g, b of the person's pixels over one track ({session}, person {})",
             obs.id
         ),
         FigureKind::Lines(LinePlot {
             x_label: "time (s)".into(),
-            y_label: "ln(channel / frame mean)".into(),
+            y_label: "channel / frame mean".into(),
             series,
             ..LinePlot::default()
         }),
@@ -110,21 +113,25 @@ pub(super) fn products(
     let Some((info, df)) = ctx
         .sessions
         .iter()
+        .filter(|(info, _)| p.datasets.contains(&info.dataset))
         .find_map(|(info, t)| t.get(FRAMES_TABLE).map(|df| (info, df)))
     else {
         return Ok(());
     };
     let rows = ReidFrameRow::read(df)?;
     let all = observations(&rows, "truth", p);
-    let obs: Vec<&Observation> = all.iter().collect();
+    let obs: Vec<&Observation> = all
+        .iter()
+        .filter(|o| o.feature(PAPER.feature).is_some())
+        .collect();
     if obs.is_empty() {
         return Ok(());
     }
-    let est = labels(&obs, Method::Paper, p)?;
+    let est = labels(&obs, &PAPER, p.nn_threshold, &Training::default())?.unwrap_or_default();
     products.figures.push(timeline(&obs, &est, &info.name));
-    if let Some(longest) = all
+    if let Some(longest) = obs
         .iter()
-        .max_by_key(|o| (o.frames, std::cmp::Reverse(o.id)))
+        .max_by_key(|o| (o.feature_frames(PAPER.feature), std::cmp::Reverse(o.id)))
     {
         products
             .figures

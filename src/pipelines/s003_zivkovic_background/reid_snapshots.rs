@@ -7,14 +7,17 @@
 //! each box with the label the paper's model (ADF) gave its local track in that clip: the top
 //! row on ground-truth local tracks (`#label (person p)`: the estimate beside the truth), the
 //! bottom row on the system's local tracks (`#label`, or `–` for a track that is no
-//! observation of the clip: too short, or ended after it). Fig. 5 is the first clip, fig. 6
-//! the second, as in the paper (clip 1: places lit alike; clip 2: across light).
+//! observation of the clip: too short, ended after it, or no frame gave its person's pixels).
+//! Fig. 5 is the first clip, fig. 6 the second, as in the paper (clip 1: places lit alike;
+//! clip 2: across light).
 
 use image::RgbImage;
 
 use super::params::{ClipParams, ReidParams};
 use super::reid::{FRAMES_TABLE, ReidFrameRow};
-use super::reid_report::{Method, Observation, in_clip, labels, observations};
+use super::reid_features::{Observation, observations};
+use super::reid_methods::{PAPER, Training, labels};
+use super::reid_report::in_clip;
 use super::snapshots::{BOXES_TABLE, IMAGE_PREFIX, SnapshotBox};
 use crate::report::Figure;
 use crate::report::columns::{i64s, read_image_table};
@@ -94,8 +97,11 @@ fn clip_figure(
     let mut per_source = Vec::new();
     for source in ["truth", "system"] {
         let all = observations(rows, source, p);
-        let obs: Vec<&Observation> = all.iter().filter(|o| in_clip(o, clip)).collect();
-        let est = labels(&obs, Method::Paper, p)?;
+        let obs: Vec<&Observation> = all
+            .iter()
+            .filter(|o| in_clip(o, clip) && o.feature(PAPER.feature).is_some())
+            .collect();
+        let est = labels(&obs, &PAPER, p.nn_threshold, &Training::default())?.unwrap_or_default();
         per_source.push((source, obs.into_iter().cloned().collect::<Vec<_>>(), est));
     }
     let (_, truth_obs, truth_est) = &per_source[0];
@@ -150,7 +156,7 @@ fn clip_figure(
     )))
 }
 
-/// Figs. 5 and 6 for the first re-identified session (the paper's two clips: the first two
+/// Figs. 5 and 6 for the first scored session (the paper's two clips: the first two
 /// clips of `[params.reid]`).
 pub(super) fn products(
     ctx: &Aggregate,
@@ -160,6 +166,7 @@ pub(super) fn products(
     let Some(tables) = ctx
         .sessions
         .iter()
+        .filter(|(info, _)| p.datasets.contains(&info.dataset))
         .find_map(|(_, t)| t.get(FRAMES_TABLE).map(|_| t))
     else {
         return Ok(());

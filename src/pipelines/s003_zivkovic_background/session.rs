@@ -122,6 +122,10 @@ pub(super) fn process(
     let mut colour = ColourRun::new(p, colour_wanted);
     let mut local = LocalRun::new(p)?;
     let mut reid = ReidRun::new(p, &s.info.dataset);
+    // a re-identified session without the exact person mask pairs its frames with the
+    // per-person id mask instead (re-identification's ceiling row), when it has one
+    let ids_topic = (!has_mask && reid.wanted() && summary.channel(&tp.person_ids).is_some())
+        .then_some(tp.person_ids.as_str());
     let mut moving = MovingRun::new(p, &p.moving, cx.camera_rides_robot);
     let mut first_stamp: Option<Nanos> = None;
     let mut frame_index: i64 = -1;
@@ -129,7 +133,7 @@ pub(super) fn process(
     let mut last_rgb: Option<RgbImage> = None;
 
     let mask_topic = has_mask.then_some(tp.mask.as_str());
-    let mut frames = camera::frames(log, &tp.image, mask_topic)?;
+    let mut frames = camera::frames(log, &tp.image, mask_topic.or(ids_topic))?;
     for f in &mut frames {
         let f = f?;
         frame_index += 1;
@@ -153,7 +157,12 @@ pub(super) fn process(
             t_s: f.stamp.0.saturating_sub(t0.0) as f64 * 1e-9,
             rgb: &f.rgb,
             view: ImageView::rgb(&f.rgb)?,
-            mask: f.mask.as_ref().map(|m| m.as_raw().as_slice()),
+            mask: mask_topic
+                .and(f.mask.as_ref())
+                .map(|m| m.as_raw().as_slice()),
+            person_ids: ids_topic
+                .and(f.mask.as_ref())
+                .map(|m| m.as_raw().as_slice()),
             truth: cx.ground_truth.nearest(f.stamp, GT_TOLERANCE_NS),
             moving: is_moving(&cx.odometry, f.stamp, &p.local_eval),
         };
@@ -163,7 +172,7 @@ pub(super) fn process(
         }
         colour.step(&frame)?;
         local.step(&frame)?;
-        reid.step(&frame, local.frame_tracks(frame.index));
+        reid.step(&frame, local.frame_tracks(frame.index), local.foreground());
         moving.step(&frame);
         last_rgb = Some(f.rgb);
     }
@@ -193,7 +202,9 @@ pub(super) fn process(
         height: i64::from(shape.1),
         has_mask,
         bad_images,
-        bad_masks: mask_topic.map_or(0, |m| skips.count(m) as i64),
+        bad_masks: mask_topic
+            .or(ids_topic)
+            .map_or(0, |m| skips.count(m) as i64),
         frames_without_mask,
         bad_ground_truth: cx.bad_ground_truth,
         bad_odometry: cx.bad_odometry,

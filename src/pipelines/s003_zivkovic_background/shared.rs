@@ -20,6 +20,9 @@ pub(super) struct Frame<'a> {
     pub view: ImageView<'a>,
     /// The exact person mask (255 = person), when the session has one for this frame.
     pub mask: Option<&'a [u8]>,
+    /// The per-person id mask (each pixel the id of the person seen there, 0 none), when a
+    /// re-identified session without an exact person mask has one for this frame.
+    pub person_ids: Option<&'a [u8]>,
     /// The ground truth joined to this frame (nearest stamp).
     pub truth: Option<&'a PeopleFrame>,
     /// Odometry says the camera moves.

@@ -302,6 +302,7 @@ mod tests {
                 rgb: &img,
                 view,
                 mask: None,
+                person_ids: None,
                 truth: None,
                 moving: false,
             };

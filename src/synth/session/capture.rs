@@ -403,9 +403,23 @@ fn write_frame(
             .iter()
             .map(|s| if *s { 255 } else { 0 })
             .collect();
+        w.write(ch, log, &mono8(header.clone(), wdt, hgt, data))?;
+    }
+    if let Some(ch) = c.id_channel {
+        let data: Vec<u8> = frame.ids.iter().map(|&id| person_id_pixel(id)).collect();
         w.write(ch, log, &mono8(header, wdt, hgt, data))?;
     }
     Ok(())
+}
+
+/// A pixel of the per-person id mask: the person's id for a person's object id, 0 for anything
+/// else, 255 for ids that do not fit.
+fn person_id_pixel(object: u32) -> u8 {
+    if object > PERSON_BASE {
+        u8::try_from(object - PERSON_BASE).unwrap_or(u8::MAX)
+    } else {
+        0
+    }
 }
 
 /// A `mono8` ground-truth mask image.

@@ -1,6 +1,7 @@
 //! The people of a session and the robot: scripted people (with the calibration walk first
-//! when it is theirs), the robot's trajectory, then the crowd (which may cross between the
-//! robot and the person it follows).
+//! when it is theirs; from `[variation]`'s first session on with clothes redrawn and some of
+//! them away), the robot's trajectory, then the crowd (which may cross between the robot and
+//! the person it follows).
 
 use std::path::{Path, PathBuf};
 
@@ -21,8 +22,11 @@ pub(super) fn people_and_robot(
     base: &Path,
     session: u64,
 ) -> Result<(Vec<Actor>, RobotTrack), SynthError> {
-    let dur = s.scenario.duration_s;
+    // the crowd is numbered after every scripted person, whether they came or not
     let first_crowd_id = first_crowd_id(s);
+    let varied = varied(s, session);
+    let s = &varied;
+    let dur = s.scenario.duration_s;
     let mut people = actors(
         first_crowd_id,
         &Scenario {
@@ -69,24 +73,81 @@ pub(super) fn people_and_robot(
     Ok((people, robot_track))
 }
 
+/// The scenario with this session's visitors (`[variation]`): from `from_session` on, the
+/// scripted people's clothes and hair are redrawn (tops without repeats) and some stay away,
+/// from a stream of their own so that nothing else of the session changes. People the robot
+/// follows or the calibration walk needs always come.
+pub(super) fn varied(s: &Scenario, session: u64) -> Scenario {
+    let mut out = s.clone();
+    let Some(v) = s
+        .variation
+        .as_ref()
+        .filter(|v| session >= u64::from(v.from_session))
+    else {
+        return out;
+    };
+    let mut r = rng::stream(s.scenario.seed, "variation", session);
+    if v.clothes {
+        let mut tops: Vec<usize> = (0..PALETTE.len()).collect();
+        for p in &mut out.people {
+            let k = r.random_range(0..tops.len().max(1));
+            p.upper = tops
+                .get(k)
+                .map_or_else(|| random_color(&mut r), |&i| PALETTE[i]);
+            if k < tops.len() {
+                tops.remove(k);
+            }
+            p.lower = random_color(&mut r);
+            p.hair = random_hair(&mut r);
+            p.hat = None;
+        }
+    }
+    let [least, most] = v.absent;
+    let away = r.random_range(least..=most) as usize;
+    let needed = |id: u32| {
+        s.robot.follow.as_ref().is_some_and(|f| f.target == id)
+            || s.calibration.as_ref().is_some_and(|c| c.person == id)
+    };
+    for _ in 0..away {
+        let free: Vec<usize> = (0..out.people.len())
+            .filter(|&i| !needed(out.people[i].id))
+            .collect();
+        if free.is_empty() {
+            break;
+        }
+        out.people.remove(free[r.random_range(0..free.len())]);
+    }
+    out
+}
+
+/// The clothing palette of crowds and varied visitors.
+const PALETTE: [[u8; 3]; 14] = [
+    [180, 40, 40],
+    [40, 70, 160],
+    [30, 30, 35],
+    [230, 230, 225],
+    [200, 170, 60],
+    [60, 120, 70],
+    [120, 60, 140],
+    [210, 120, 40],
+    [90, 90, 95],
+    [150, 180, 210],
+    [120, 80, 50],
+    [240, 200, 200],
+    [20, 90, 100],
+    [170, 40, 100],
+];
+
 fn random_color(r: &mut rand_chacha::ChaCha8Rng) -> [u8; 3] {
-    const PALETTE: [[u8; 3]; 14] = [
-        [180, 40, 40],
-        [40, 70, 160],
-        [30, 30, 35],
-        [230, 230, 225],
-        [200, 170, 60],
-        [60, 120, 70],
-        [120, 60, 140],
-        [210, 120, 40],
-        [90, 90, 95],
-        [150, 180, 210],
-        [120, 80, 50],
-        [240, 200, 200],
-        [20, 90, 100],
-        [170, 40, 100],
-    ];
     PALETTE[r.random_range(0..PALETTE.len())]
+}
+
+fn random_hair(r: &mut rand_chacha::ChaCha8Rng) -> [u8; 3] {
+    [
+        50 + r.random_range(0..60u8),
+        35 + r.random_range(0..40u8),
+        25,
+    ]
 }
 
 fn skin_tone(r: &mut rand_chacha::ChaCha8Rng) -> [u8; 3] {
@@ -313,11 +374,7 @@ fn actors(
                 upper: random_color(&mut r),
                 lower: random_color(&mut r),
                 skin: skin_tone(&mut r),
-                hair: [
-                    50 + r.random_range(0..60u8),
-                    35 + r.random_range(0..40u8),
-                    25,
-                ],
+                hair: random_hair(&mut r),
                 hat: None,
                 hands: false,
             };
@@ -422,4 +479,52 @@ fn actors(
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn home_tour() -> Scenario {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("datasets/home_tour/scenario.toml");
+        Scenario::load(&path, "full").expect("home_tour loads").0
+    }
+
+    fn looks(s: &Scenario) -> Vec<(u32, [u8; 3], [u8; 3])> {
+        s.people.iter().map(|p| (p.id, p.upper, p.lower)).collect()
+    }
+
+    #[test]
+    fn sessions_before_the_variation_keep_the_cast_and_later_ones_get_visitors_of_their_own() {
+        let s = home_tour();
+        assert_eq!(s.scenario.first_session, 1);
+        let v = s.variation.as_ref().expect("[variation]");
+        assert_eq!((v.from_session, v.absent), (1, [0, 1]));
+        // session 0: the cast as written
+        assert_eq!(looks(&varied(&s, 0)), looks(&s));
+        let mut seen = Vec::new();
+        for session in 1..=10 {
+            let a = varied(&s, session);
+            assert_eq!(looks(&a), looks(&varied(&s, session)), "deterministic");
+            assert!(
+                (5..=6).contains(&a.people.len()),
+                "{} visitors",
+                a.people.len()
+            );
+            let mut tops: Vec<[u8; 3]> = a.people.iter().map(|p| p.upper).collect();
+            assert!(tops.iter().all(|t| PALETTE.contains(t)));
+            tops.sort_unstable();
+            tops.dedup();
+            assert_eq!(tops.len(), a.people.len(), "tops all different");
+            // the people who came walk as scripted
+            for p in &a.people {
+                let orig = s.people.iter().find(|q| q.id == p.id).expect("scripted");
+                assert_eq!((p.height, p.enter_s), (orig.height, orig.enter_s));
+            }
+            seen.push(looks(&a));
+        }
+        seen.sort();
+        seen.dedup();
+        assert_eq!(seen.len(), 10, "every session has a cast of its own");
+    }
 }

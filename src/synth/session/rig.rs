@@ -42,6 +42,8 @@ pub(super) struct CameraSensor {
     pub channels: (ChannelId, ChannelId, Option<ChannelId>),
     /// Ground-truth skin mask channel, when the camera records one (`skin_mask = true`).
     pub skin_channel: Option<ChannelId>,
+    /// Per-person id mask channel, when the camera records one (`id_mask = true`).
+    pub id_channel: Option<ChannelId>,
 }
 
 /// A laser scanner as the session runs it.
@@ -296,6 +298,11 @@ impl Builder<'_> {
         } else {
             None
         };
+        let id_channel = if camera.id_mask {
+            Some(w.add_ros2::<Image>(&format!("/{}/ground_truth_ids", camera.name))?)
+        } else {
+            None
+        };
         self.sensors.push(SensorRuntime::Camera(CameraSensor {
             cam: Box::new(cam),
             frame_id: camera.name.clone(),
@@ -307,6 +314,7 @@ impl Builder<'_> {
             mask: camera.mask,
             channels: (image_ch, info_ch, mask_ch),
             skin_channel,
+            id_channel,
         }));
         Ok(())
     }

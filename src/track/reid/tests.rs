@@ -347,3 +347,97 @@ fn overlapping_tracks_are_never_the_same_person_and_bad_features_are_errors() {
         Err(ReidError::NotFinite)
     );
 }
+
+#[test]
+fn the_moved_prior_sits_at_the_mean_look_with_the_pooled_spreads() {
+    let printed = Prior::paper(2);
+    // person A: (1, 2), (3, 2); person B: (0, 0), (0, 4), (0, 2); person C seen once: (2, 2)
+    let people = vec![
+        vec![vec![1.0, 2.0], vec![3.0, 2.0]],
+        vec![vec![0.0, 0.0], vec![0.0, 4.0], vec![0.0, 2.0]],
+        vec![vec![2.0, 2.0]],
+    ];
+    let m = printed.moved(&people).expect("fits");
+    // a₀: the mean of the six looks
+    assert_eq!(m.prior.a0, vec![1.0, 2.0]);
+    // within: A 1 + 1 + 0 + 0, B 0 + 8 over (1 + 2) looks beyond the first, 2 dimensions
+    let var: f64 = 10.0 / 6.0;
+    assert!((m.within_sd - var.sqrt()).abs() < 1e-15);
+    // between: the means (2, 2), (0, 2), (2, 2) spread 8/3 / (2 · 2) = 2/3, less the looks'
+    // noise var · (1/2 + 1/3 + 1)/3: nothing left, so κ₀ takes its floor
+    assert_eq!((m.between_sd, m.prior.kappa0), (0.0, KAPPA0_MIN));
+    // C₀: a once-seen kernel's predictive scale 2·s_w², with λ₁ = 2 and ν = η₀ − r + 2 = 2
+    assert!((m.prior.c0 - 2.0 * var * 2.0 * 2.0 / 3.0).abs() < 1e-12);
+    assert_eq!(m.prior.eta0, 2.0);
+    assert_eq!((m.observations, m.people), (6, 3));
+    // two people far apart: κ₀ is the ratio of the spreads
+    let far = vec![
+        vec![vec![0.0, 0.0], vec![2.0, 0.0]],
+        vec![vec![10.0, 0.0], vec![12.0, 0.0]],
+    ];
+    let m = printed.moved(&far).expect("fits");
+    // within 4 / (2 · 2) = 1; between (25 + 25) / 2 − 1 · 1/2 = 24.5
+    assert_eq!((m.within_sd, m.between_sd), (1.0, 24.5f64.sqrt()));
+    assert_eq!(m.prior.kappa0, 24.5);
+    let l1 = 1.0 / 24.5 + 1.0;
+    assert!((m.prior.c0 - 2.0 * l1 * 2.0 / (l1 + 1.0)).abs() < 1e-12);
+    // nobody seen twice, one person only, or a look of another dimension: nothing to fit
+    assert_eq!(
+        printed.moved(&[vec![vec![1.0, 2.0]], vec![vec![0.0, 1.0]]]),
+        None
+    );
+    assert_eq!(printed.moved(&[vec![vec![1.0, 2.0], vec![0.0, 1.0]]]), None);
+    assert_eq!(
+        printed.moved(&[vec![vec![1.0], vec![2.0]], vec![vec![0.0]]]),
+        None
+    );
+}
+
+#[test]
+fn far_from_the_printed_a0_two_people_merge_and_the_moved_prior_tells_them_apart() {
+    // features near 1 (a channel-normalised space), two people 0.3 apart in every dimension,
+    // each seen twice with a spread of 0.02: under a₀ = 0 the prior's predictive is so far
+    // that joining a known kernel wins; at the moved a₀ a new person is likelier
+    let r = 9;
+    let look = |base: f64, k: usize| -> Vec<f64> {
+        (0..r)
+            .map(|j| {
+                base + if (j + k).is_multiple_of(2) {
+                    0.02
+                } else {
+                    -0.02
+                }
+            })
+            .collect()
+    };
+    let seq = [(0.9, 0), (1.2, 0), (0.9, 1), (1.2, 1)];
+    let people = vec![
+        vec![look(0.8, 0), look(0.8, 1)],
+        vec![look(1.1, 0), look(1.1, 1)],
+    ];
+    let run = |prior: &Prior| -> Vec<usize> {
+        let mut f = ReidFilter::new(prior, Terms::default());
+        seq.iter()
+            .enumerate()
+            .map(|(i, (b, k))| {
+                let t = 10.0 * i as f64;
+                f.observe(
+                    &look(*b, *k),
+                    Span {
+                        enter: t,
+                        leave: t + 1.0,
+                    },
+                )
+                .expect("observe")
+                .label
+            })
+            .collect()
+    };
+    assert_eq!(
+        run(&Prior::paper(r)),
+        [1, 1, 1, 1],
+        "printed prior: one person"
+    );
+    let moved = Prior::paper(r).moved(&people).expect("fits").prior;
+    assert_eq!(run(&moved), [1, 2, 1, 2], "moved prior: two people");
+}

@@ -377,3 +377,30 @@ fn after_the_warm_up_a_still_person_joins_the_background_at_the_steady_rate() {
         "bootstrap absorbed after {bootstrap} frames"
     );
 }
+
+#[test]
+fn the_foreground_is_the_persons_pixels_once_blobs_are_taken_and_none_before() {
+    let mut t = LocalTracker::new(params()).expect("tracker");
+    // the warm-up (8 frames) on the empty scene: no foreground to read
+    for k in 0..8 {
+        step(&mut t, &frame(k, 0, None), false);
+        assert!(t.foreground().is_none(), "warm-up frame {k}");
+    }
+    for k in 8..20 {
+        step(&mut t, &frame(k, 0, None), false);
+    }
+    let person = (40, 30);
+    step(&mut t, &frame(20, 0, Some(person)), false);
+    let fg = t.foreground().expect("blobs are taken");
+    // exactly the person's rectangle, less the corners the 3×3 majority filter rounds off
+    let inside = |i: usize| {
+        let (x, y) = ((i % W) as i64, (i / W) as i64);
+        x >= person.0 && x < person.0 + PW && y >= person.1 && y < person.1 + PH
+    };
+    let on: Vec<usize> = (0..W * H).filter(|&i| fg[i] == FOREGROUND).collect();
+    assert!(on.iter().all(|&i| inside(i)), "foreground off the person");
+    assert_eq!(on.len() as i64, PW * PH - 4);
+    // the camera moves: no foreground
+    step(&mut t, &frame(21, 3, Some(person)), true);
+    assert!(t.foreground().is_none());
+}
