@@ -220,11 +220,17 @@ impl Table {
 }
 
 /// Parquet bytes of a frame, with provenance as key-value metadata.
+///
+/// Written and read without polars' own thread pool: these run inside the runner's per-session
+/// rayon jobs, and a job that waits on another pool lets its thread start further sessions
+/// meanwhile, so the stack grew with the number of sessions (a 1,000-session aggregate
+/// overflowed it); one table of one session gains nothing from parallel columns.
 pub fn parquet_bytes(df: &DataFrame, provenance: &Provenance) -> PolarsResult<Vec<u8>> {
     let mut buf = Vec::new();
     let mut df = df.clone();
     let meta = serde_json::to_string(provenance).unwrap_or_default();
     ParquetWriter::new(&mut buf)
+        .set_parallel(false)
         .with_key_value_metadata(Some(KeyValueMetadata::from_static(vec![(
             "peopletrack.provenance".to_string(),
             meta,
@@ -233,10 +239,13 @@ pub fn parquet_bytes(df: &DataFrame, provenance: &Provenance) -> PolarsResult<Ve
     Ok(buf)
 }
 
-/// Read a Parquet file written by [`parquet_bytes`] (or any tool).
+/// Read a Parquet file written by [`parquet_bytes`] (or any tool), on the calling thread (see
+/// [`parquet_bytes`]).
 pub fn read_parquet(path: &Path) -> PolarsResult<DataFrame> {
     let f = std::fs::File::open(path)?;
-    ParquetReader::new(f).finish()
+    ParquetReader::new(f)
+        .read_parallel(ParallelStrategy::None)
+        .finish()
 }
 
 fn provenance_line(p: &Provenance) -> String {
