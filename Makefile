@@ -32,6 +32,8 @@ release:
 
 datasets: release
 	./target/release/peopletrack synth --if-absent --profile $(PROFILE) datasets/*/scenario.toml
+	@# re-identification's training split (seed 003, never scored): home_tour's tours 90-92
+	[ -n "$(wildcard datasets/home_tour_train/*.mcap)" ] || ./target/release/peopletrack synth --profile train --out datasets/home_tour_train datasets/home_tour/scenario.toml
 
 eval: datasets
 	./target/release/peopletrack eval --profile $(PROFILE)
