@@ -177,6 +177,21 @@ fn tests(rows: &[HeightRow], persons: &[PersonHeightRow], level: f64) -> Vec<Hei
         });
         out.push(test("person", model, &e, &t, level));
     }
+    // each person on their own: learned against true height over that person's sessions (the
+    // full profile has two per person, so these tests have one degree of freedom)
+    for person in persons.iter().filter(|p| p.sessions >= 2) {
+        let mine = |r: &&HeightRow| (r.truth_m - person.truth_m).abs() < 5e-4;
+        for (model, walk) in [("constant", false), ("random walk", true)] {
+            let e: Vec<f64> = rows
+                .iter()
+                .filter(mine)
+                .filter_map(|r| if walk { r.error_walk_m } else { r.error_m })
+                .collect();
+            let t = vec![person.truth_m; e.len()];
+            let unit = format!("person {:.2} m", person.truth_m);
+            out.push(test(&unit, model, &e, &t, level));
+        }
+    }
     out
 }
 
@@ -242,7 +257,7 @@ pub fn tables(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow::R
         t = t.with_precision(c, 4);
     }
     out.tables.push(t.with_note(format!(
-        "Two-sided, level {}; ci of the mean error. unit = person: each person's mean error over their sessions. The paper reports one trial ({PAPER_HEIGHT_M} m vs {PAPER_TRUTH_M} m: +0.03 m), so it has no test.",
+        "Two-sided, level {}; ci of the mean error. unit = person: each person's mean error over their sessions; unit = person <h> m: that person's sessions alone (n = their sessions). The paper reports one trial ({PAPER_HEIGHT_M} m vs {PAPER_TRUTH_M} m: +0.03 m), so it has no test.",
         p.level
     )));
     Ok(())
@@ -289,7 +304,7 @@ mod tests {
             (Some(1.86), Some(1.88))
         );
         let t = tests(&rows, &p, 0.95);
-        assert_eq!(t.len(), 4);
+        assert_eq!(t.len(), 8);
         // sessions: errors 0.02, 0.01, 0.04, 0.03 — mean 0.025, sd 0.012910, t = 3.873
         let s = &t[0];
         assert_eq!(
@@ -304,5 +319,16 @@ mod tests {
         assert_eq!(t[1].n, 2);
         assert!((t[1].mean_error_m.expect("some") - 0.025).abs() < 1e-12);
         assert!((t[2].mean_error_m.expect("some") - 0.065).abs() < 1e-12);
+        // each person alone: 1.55 m has errors 0.01 and 0.03 — mean 0.02, sd √2·0.01, so
+        // t = 0.02 / (√2·0.01 / √2) = 2 with one degree of freedom
+        let one = &t[4];
+        assert_eq!(
+            (one.unit.as_str(), one.height_model.as_str(), one.n),
+            ("person 1.55 m", "constant", 2)
+        );
+        assert!((one.t.expect("t") - 2.0).abs() < 1e-9);
+        assert_eq!((one.truth_min_m, one.truth_max_m), (1.55, 1.55));
+        assert_eq!(t[7].unit, "person 1.84 m");
+        assert_eq!(t[7].height_model, "random walk");
     }
 }
