@@ -7,8 +7,15 @@ use std::io::Cursor;
 pub enum WavError {
     #[error("WAV: {samples} samples do not split into {channels} channels")]
     Interleave { samples: usize, channels: u16 },
+    // no `#[from]`: a source would be printed twice in an error chain (`From` is below)
     #[error("WAV: {0}")]
-    Hound(#[from] hound::Error),
+    Hound(hound::Error),
+}
+
+impl From<hound::Error> for WavError {
+    fn from(e: hound::Error) -> Self {
+        WavError::Hound(e)
+    }
 }
 
 /// A WAV file (RIFF, PCM, 16-bit) holding `samples` interleaved over `channels` at

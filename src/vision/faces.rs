@@ -65,8 +65,9 @@ impl Face {
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FaceError {
+    // no `#[from]`: a source would be printed twice in an error chain (`From` is below)
     #[error("face detection: {0}")]
-    View(#[from] ViewError),
+    View(ViewError),
     #[error("face detection needs a grey image, got {channels} channels")]
     Channels { channels: usize },
     #[error("face detection: the image is {width}x{height}, larger than 32767 px a side")]
@@ -75,6 +76,12 @@ pub enum FaceError {
     Params(String),
     #[error("face model: {0}")]
     Model(String),
+}
+
+impl From<ViewError> for FaceError {
+    fn from(e: ViewError) -> Self {
+        FaceError::View(e)
+    }
 }
 
 /// The SeetaFace frontal detector with its settings.
