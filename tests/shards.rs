@@ -77,8 +77,8 @@ fn recorded(out: &Path, k: usize, n: usize) -> Vec<String> {
         .map(|s| {
             format!(
                 "{}/{}",
-                s["dataset"].as_str().unwrap(),
-                s["name"].as_str().unwrap()
+                s["dataset"].as_str().expect("dataset"),
+                s["name"].as_str().expect("name")
             )
         })
         .collect()

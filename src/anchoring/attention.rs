@@ -13,11 +13,13 @@
 //! - `listen`: the focus is in category 3 — the robot "assumes to be addressed and considers
 //!   the corresponding person to be a potential communication partner" (speech recognition
 //!   runs only here and in `interact`, seed §V).
+//!
 //! Top-down attention — "activated as soon as the robot starts to interact with a particular
 //! person", i.e. on a greeting from the dialog by the person in focus:
 //! - `interact`: the focus stays on the partner "even if it is not speaking"; transitions
 //!   are triggered by dialog commands only: good-bye from the partner, or the partner
 //!   leaving (its anchor is gone), returns to bottom-up.
+//!
 //! BIRON's further top-down states (follow, object) are not modelled.
 
 use serde::{Deserialize, Serialize};

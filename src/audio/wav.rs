@@ -21,7 +21,7 @@ impl From<hound::Error> for WavError {
 /// A WAV file (RIFF, PCM, 16-bit) holding `samples` interleaved over `channels` at
 /// `sample_rate` Hz.
 pub fn wav_bytes(samples: &[i16], channels: u16, sample_rate: u32) -> Result<Vec<u8>, WavError> {
-    if channels == 0 || samples.len() % usize::from(channels) != 0 {
+    if channels == 0 || !samples.len().is_multiple_of(usize::from(channels)) {
         return Err(WavError::Interleave {
             samples: samples.len(),
             channels,

@@ -53,12 +53,11 @@ pub fn read(log: &SessionLog, topic: &str) -> Result<(AudioStream, Skips), LogEr
     let info_t = info_topic(topic);
     let mut dec = Decoders::new();
     let mut info: Option<AudioInfo> = None;
-    if log.summary().channel(&info_t).is_some() {
-        for m in log.messages_on(&[info_t.as_str()])? {
-            let m = m?;
-            info = Some(dec.typed::<AudioInfo>(log, &m)?);
-            break;
-        }
+    if log.summary().channel(&info_t).is_some()
+        && let Some(m) = log.messages_on(&[info_t.as_str()])?.next()
+    {
+        let m = m?;
+        info = Some(dec.typed::<AudioInfo>(log, &m)?);
     }
     let info = info.ok_or_else(|| bad(log, topic, format!("no AudioInfo on {info_t}")))?;
     if info.sample_format != "S16LE" || info.channels != 2 || info.sample_rate == 0 {

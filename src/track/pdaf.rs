@@ -55,6 +55,9 @@ use self::models::{Cov, Motion, State};
 use super::jpda::{combined_update, gate_probability};
 use super::kalman::{Kalman, KalmanError};
 
+/// One mode's state `[x, y, vx, vy, ω]` and its covariance.
+pub type ModeState = ([f64; 5], [[f64; 5]; 5]);
+
 /// The motion model.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -651,7 +654,7 @@ impl TargetFilter {
 
     /// Each mode's state and covariance (one for CV or CT; CV then CT for IMM) and the mode
     /// probabilities (after a prediction: the predicted ones).
-    pub fn mode_states(&self) -> (Vec<([f64; 5], [[f64; 5]; 5])>, Vec<f64>) {
+    pub fn mode_states(&self) -> (Vec<ModeState>, Vec<f64>) {
         let modes = self
             .modes
             .iter()

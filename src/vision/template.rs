@@ -187,7 +187,7 @@ impl Silhouette {
     /// lean line stays where it was), for people whose arms and clothes make them wider than
     /// the profile's torso. Apply before [`Silhouette::grown`] and [`Silhouette::padded`].
     pub fn widened(self, factor: f64) -> Silhouette {
-        if !(factor > 0.0) || factor == 1.0 || self.spans.is_empty() {
+        if factor.is_nan() || factor <= 0.0 || factor == 1.0 || self.spans.is_empty() {
             return self;
         }
         let raw: Vec<(i64, i64)> = self

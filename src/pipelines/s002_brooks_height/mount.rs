@@ -330,7 +330,7 @@ fn legend_headroom(series: &[Series]) -> Option<(f64, f64)> {
         (lo.min(y), hi.max(y))
     });
     let span = (hi - lo).max(1e-3);
-    (lo.is_finite() && hi.is_finite()).then(|| (lo - 0.05 * span, hi + LEGEND_HEADROOM * span))
+    (lo.is_finite() && hi.is_finite()).then_some((lo - 0.05 * span, hi + LEGEND_HEADROOM * span))
 }
 
 #[cfg(test)]

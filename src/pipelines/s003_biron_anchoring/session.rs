@@ -46,7 +46,7 @@ pub struct Topics {
 
 fn first_camera(log: &SessionLog, topic: &str) -> anyhow::Result<crate::geometry::camera::Pinhole> {
     let mut dec = Decoders::new();
-    for m in log.messages_on(&[topic])? {
+    if let Some(m) = log.messages_on(&[topic])?.next() {
         let m = m?;
         let info: CameraInfo = dec.typed(log, &m)?;
         return match info.model()? {

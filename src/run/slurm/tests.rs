@@ -85,21 +85,21 @@ fn shard_from_slurm_and_kubernetes_environments() {
         ("SLURM_ARRAY_TASK_ID", "3"),
         ("SLURM_ARRAY_TASK_COUNT", "8"),
     ]);
-    assert_eq!(shard_from_env(slurm).unwrap(), (3, 8));
+    assert_eq!(shard_from_env(slurm).expect("a shard"), (3, 8));
     // an array numbered 0-7: task 0 is shard 1
     let zero = env(&[
         ("SLURM_ARRAY_TASK_ID", "0"),
         ("SLURM_ARRAY_TASK_MIN", "0"),
         ("SLURM_ARRAY_TASK_COUNT", "8"),
     ]);
-    assert_eq!(shard_from_env(zero).unwrap(), (1, 8));
+    assert_eq!(shard_from_env(zero).expect("a shard"), (1, 8));
     let k8s = env(&[("JOB_COMPLETION_INDEX", "7"), ("PEOPLETRACK_SHARDS", "8")]);
-    assert_eq!(shard_from_env(k8s).unwrap(), (8, 8));
+    assert_eq!(shard_from_env(k8s).expect("a shard"), (8, 8));
 }
 
 #[test]
 fn shard_from_env_names_what_is_missing_or_wrong() {
-    let msg = |e: anyhow::Result<(usize, usize)>| format!("{:#}", e.unwrap_err());
+    let msg = |e: anyhow::Result<(usize, usize)>| format!("{:#}", e.expect_err("an error"));
     assert!(msg(shard_from_env(env(&[]))).contains("SLURM_ARRAY_TASK_ID"));
     assert!(
         msg(shard_from_env(env(&[("SLURM_ARRAY_TASK_ID", "2")])))

@@ -84,7 +84,7 @@ pub fn route(
             if inside(p) && segment_clear(at, p, obstacles, spec.clearance_m) {
                 break Some((p, dir, len, bound > spec.max_turn_deg.to_radians()));
             }
-            if tries % TRIES_PER_BOUND == 0 {
+            if tries.is_multiple_of(TRIES_PER_BOUND) {
                 if bound >= std::f64::consts::PI {
                     break None;
                 }

@@ -77,10 +77,13 @@ fn parts(p: &Params) -> Vec<(String, i64, i64)> {
     out
 }
 
+/// One noise run as `table` lists them: the level's index and name, the association, and the level's key columns.
+type NoiseJob = (usize, String, String, (String, i64, i64));
+
 pub(super) fn table(s: &Scored, p: &Params) -> anyhow::Result<Table> {
     let t = s.thresholds[0];
     let gt_all = truth_observations(&s.data);
-    let jobs: Vec<(usize, String, String, (String, i64, i64))> = p
+    let jobs: Vec<NoiseJob> = p
         .detector_noise
         .iter()
         .enumerate()
