@@ -76,6 +76,13 @@ impl Table {
         self
     }
 
+    /// [`Table::with_precision`] for several columns at once.
+    pub fn with_precisions(self, columns: &[&str], decimals: usize) -> Table {
+        columns
+            .iter()
+            .fold(self, |t, c| t.with_precision(c, decimals))
+    }
+
     pub fn with_note(mut self, note: impl Into<String>) -> Table {
         self.notes.push(note.into());
         self

@@ -203,18 +203,19 @@ pub fn tables(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow::R
         "Height learned by laser + camera at the end of each session vs the truth (seed 002 §6: 1.87 m vs 1.84 m)",
         HeightRow::frame(&rows)?,
     );
-    for c in [
-        "truth_m",
-        "final_m",
-        "sigma_m",
-        "error_m",
-        "final_walk_m",
-        "error_walk_m",
-        "final_cv_m",
-        "first_camera_s",
-    ] {
-        t = t.with_precision(c, 3);
-    }
+    t = t.with_precisions(
+        &[
+            "truth_m",
+            "final_m",
+            "sigma_m",
+            "error_m",
+            "final_walk_m",
+            "error_walk_m",
+            "final_cv_m",
+            "first_camera_s",
+        ],
+        3,
+    );
     out.tables.push(t.with_note(format!(
         "EKF over (x, y, h), constant position, h0 = {} m with sigma {} m, 3-sigma gate (Mahalanobis <= {}); the height a constant the filter learns (q_height = {} m²/s, the paper's model); final_walk_m: the random-walk variant (q_height_walk = {} m²/s). camera/laser accepted and rejected count observation events (a rejected camera event is one whose every detection implied a state outside the gate). first_camera_s: first camera detection after the filter started.",
         p.h0_m, p.sigma_h0_m, p.gate_sigma, p.q_height, p.q_height_walk
@@ -225,17 +226,18 @@ pub fn tables(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow::R
         "Learned height per person (sessions grouped by true height) against the truth",
         PersonHeightRow::frame(&persons)?,
     );
-    for c in [
-        "truth_m",
-        "mean_final_m",
-        "mean_error_m",
-        "min_final_m",
-        "max_final_m",
-        "mean_final_walk_m",
-        "mean_error_walk_m",
-    ] {
-        t = t.with_precision(c, 3);
-    }
+    t = t.with_precisions(
+        &[
+            "truth_m",
+            "mean_final_m",
+            "mean_error_m",
+            "min_final_m",
+            "max_final_m",
+            "mean_final_walk_m",
+            "mean_error_walk_m",
+        ],
+        3,
+    );
     out.tables.push(t.with_note(
         "A person is a true height (synthetic people of one height); the paper measured one person once (1.87 m learned vs 1.84 m taped).",
     ));
@@ -244,18 +246,19 @@ pub fn tables(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow::R
         "Learned − true height: mean, std and a one-sample t-test against 0, over sessions and over people",
         HeightTestRow::frame(&tests(&rows, &persons, p.level))?,
     );
-    for c in [
-        "truth_min_m",
-        "truth_max_m",
-        "mean_error_m",
-        "std_error_m",
-        "t",
-        "p_two_sided",
-        "ci_low_m",
-        "ci_high_m",
-    ] {
-        t = t.with_precision(c, 4);
-    }
+    t = t.with_precisions(
+        &[
+            "truth_min_m",
+            "truth_max_m",
+            "mean_error_m",
+            "std_error_m",
+            "t",
+            "p_two_sided",
+            "ci_low_m",
+            "ci_high_m",
+        ],
+        4,
+    );
     out.tables.push(t.with_note(format!(
         "Two-sided, level {}; ci of the mean error. unit = person: each person's mean error over their sessions; unit = person <h> m: that person's sessions alone (n = their sessions). The paper reports one trial ({PAPER_HEIGHT_M} m vs {PAPER_TRUTH_M} m: +0.03 m), so it has no test.",
         p.level

@@ -205,24 +205,25 @@ pub fn products(cams: &[MountCamera], p: &Params, out: &mut Products) -> anyhow:
         "Seed 002's filters against the camera's mount: the same walks seen from cameras at several heights (camera only: the paper's second trial)",
         MountRow::frame(&per_camera)?,
     );
-    for c in [
-        "camera_z_m",
-        "head_dz_m",
-        "range_per_mrad_m",
-        "camera_frames_per_session",
-        "learned_error_m",
-        "learned_error_sd_m",
-        "laser_only_error_m",
-        "fused_error_m",
-        "camera_only_error_m",
-        "camera_only_walk_error_m",
-        "walk_t",
-        "walk_p",
-        "camera_only_height_error_m",
-        "camera_only_walk_height_error_m",
-    ] {
-        t = t.with_precision(c, 3);
-    }
+    t = t.with_precisions(
+        &[
+            "camera_z_m",
+            "head_dz_m",
+            "range_per_mrad_m",
+            "camera_frames_per_session",
+            "learned_error_m",
+            "learned_error_sd_m",
+            "laser_only_error_m",
+            "fused_error_m",
+            "camera_only_error_m",
+            "camera_only_walk_error_m",
+            "walk_t",
+            "walk_p",
+            "camera_only_height_error_m",
+            "camera_only_walk_height_error_m",
+        ],
+        3,
+    );
     out.tables.push(t.with_note(format!(
         "Means over sessions. range_per_mrad_m: (rho² + dz²)/|dz| × 1 mrad at rho = {REFERENCE_RANGE_M} m, the range one mrad of elevation error moves (a pixel is about 3.8 mrad here). learned_error: the height laser + camera learns (constant height) minus the truth; camera only starts from it (height_from = {}); walk: q_height_walk = {} m²/s in both trials; walk_t / walk_p: paired t-test across sessions of camera only's mean error, constant − walk. Every camera looks at the same point; its detector values are the paper run's (chosen on office_network's 2.2 m camera).",
         p.height_from.name(),
@@ -233,19 +234,20 @@ pub fn products(cams: &[MountCamera], p: &Params, out: &mut Products) -> anyhow:
         "The mount table per camera and session",
         MountSessionRow::frame(&per_session)?,
     );
-    for c in [
-        "camera_z_m",
-        "truth_m",
-        "learned_m",
-        "learned_walk_m",
-        "fused_error_m",
-        "camera_only_error_m",
-        "camera_only_walk_error_m",
-        "camera_only_final_m",
-        "camera_only_walk_final_m",
-    ] {
-        t = t.with_precision(c, 3);
-    }
+    t = t.with_precisions(
+        &[
+            "camera_z_m",
+            "truth_m",
+            "learned_m",
+            "learned_walk_m",
+            "fused_error_m",
+            "camera_only_error_m",
+            "camera_only_walk_error_m",
+            "camera_only_final_m",
+            "camera_only_walk_final_m",
+        ],
+        3,
+    );
     out.tables.push(t);
     out.figures.push(figure(&per_camera));
     Ok(())

@@ -104,18 +104,19 @@ pub fn tables(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow::R
         "Camera only (seed 002's second trial) per session: the height a constant vs a random walk",
         WalkRow::frame(&rows)?,
     );
-    for c in [
-        "truth_m",
-        "height_from_truth_m",
-        "start_m",
-        "final_m",
-        "mean_error_m",
-        "start_walk_m",
-        "final_walk_m",
-        "mean_error_walk_m",
-    ] {
-        t = t.with_precision(c, 3);
-    }
+    t = t.with_precisions(
+        &[
+            "truth_m",
+            "height_from_truth_m",
+            "start_m",
+            "final_m",
+            "mean_error_m",
+            "start_walk_m",
+            "final_walk_m",
+            "mean_error_walk_m",
+        ],
+        3,
+    );
     let warn = if other > 0 {
         format!(
             " WARNING: {other} session(s) start from another person's height (height_from_truth_m differs): check height_from."
@@ -138,17 +139,18 @@ pub fn tables(data: &[SessionData], p: &Params, out: &mut Products) -> anyhow::R
         "Constant height vs height random walk: paired t-test across sessions of the per-session mean position error",
         WalkTestRow::frame(&tests)?,
     );
-    for c in [
-        "mean_constant_m",
-        "mean_walk_m",
-        "mean_diff_m",
-        "t",
-        "p_two_sided",
-        "ci_low_m",
-        "ci_high_m",
-    ] {
-        t = t.with_precision(c, 4);
-    }
+    t = t.with_precisions(
+        &[
+            "mean_constant_m",
+            "mean_walk_m",
+            "mean_diff_m",
+            "t",
+            "p_two_sided",
+            "ci_low_m",
+            "ci_high_m",
+        ],
+        4,
+    );
     out.tables.push(t.with_note(format!(
         "Two-sided, level {}; one pair per session (sessions are independent walks, unlike the stamps of paired_ttest). method: the constant-height method; its walk variant is the same sensors with q_height_walk.",
         p.level
