@@ -1,7 +1,7 @@
 //! Bad input gives one clear error naming the file (and the topic and time where they are
 //! known) — never a panic, never silently wrong data.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

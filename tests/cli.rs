@@ -1,6 +1,6 @@
 //! The CLI end to end: `inspect` and `cat` on real logs, errors as exit codes.
 
-mod common;
+use crate::common;
 
 use assert_cmd::Command;
 

@@ -6,7 +6,7 @@
 //! scratch folder. No sleeps and no timing assertions: both processes are started, both are
 //! waited for, and whichever of the allowed outcomes happened is checked exactly.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};

@@ -2,7 +2,7 @@
 //! project's own `leg_tracker/msg/Person`) against the dynamic decoder on every message of the
 //! real logs (written by rosbags, not by us), and on a log we write with every fast type.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 use std::path::Path;

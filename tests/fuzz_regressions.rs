@@ -1,7 +1,7 @@
 //! Inputs that crashed a `cargo fuzz` target (`fuzz/`, `make fuzz`), rebuilt here as crafted
 //! bytes: each must now give a clear error.
 
-mod common;
+use crate::common;
 
 use common::raw_mcap as raw;
 use peopletrack::Nanos;

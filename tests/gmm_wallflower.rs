@@ -9,7 +9,7 @@
 //! The MOG2-defaults model is also pinned to OpenCV's numbers at that frame (F = 0.9392,
 //! FP 645, FN 102), which the README and the `wallflower` table claim.
 
-mod common;
+use crate::common;
 
 use peopletrack::vision::score::{MaskCounts, ShadowAs};
 use peopletrack::vision::{AdaptiveGmm, GmmParams, ImageView};

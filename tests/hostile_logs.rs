@@ -2,7 +2,7 @@
 //! file, topic and schema — never a stack overflow, a wrapped length or gigabytes of memory —
 //! and indexes that lie never hide or reorder messages. Every log here is crafted by the test.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

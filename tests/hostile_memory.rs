@@ -7,22 +7,16 @@
 //! Set `PEOPLETRACK_KEEP_HOSTILE=DIR` to keep the crafted files (to measure `cat` with
 //! `/usr/bin/time -v`).
 
-#[path = "support/counting_alloc.rs"]
-mod counting_alloc;
-
-mod common;
+use crate::common;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering::Relaxed;
 
-use counting_alloc::{CURRENT, Counting, PEAK};
+use crate::support::counting_alloc::{CURRENT, PEAK};
 
 use common::raw_mcap as raw;
 use peopletrack::log::{Decoders, SessionLog};
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
 
 const MIB: usize = 1 << 20;
 
@@ -77,6 +71,7 @@ fn bomb_chunk() -> Vec<u8> {
 
 #[test]
 fn hostile_logs_stay_within_64_mib_beyond_the_largest_message() {
+    let _alone = crate::support::counting_alloc::alone();
     let dir = tempfile::tempdir().expect("tempdir");
 
     // three time-overlapping chunks of 2 GiB each in a small file: it used to peak at 6.2 GB

@@ -3,7 +3,7 @@
 //! back through the same calibration code the pipelines use; then the real dataset (SKIPPED
 //! when `../shared/real/wildtrack` is absent).
 
-mod common;
+use crate::common;
 
 use std::f64::consts::FRAC_PI_2;
 use std::path::Path;

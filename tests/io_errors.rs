@@ -9,7 +9,7 @@
 //! permission cases (mode 555, an unreadable folder) run only where permissions hold
 //! (SKIPPED, with a message, for a privileged user).
 
-mod common;
+use crate::common;
 
 use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};

@@ -1,19 +1,13 @@
 //! Reading is streaming: the peak heap while reading every message of a log ten times longer
 //! stays flat. Measured with a counting global allocator (exact and deterministic, unlike RSS).
 
-#[path = "support/counting_alloc.rs"]
-mod counting_alloc;
-
 use std::sync::atomic::Ordering::Relaxed;
 
-use counting_alloc::{CURRENT, Counting, PEAK};
+use crate::support::counting_alloc::{CURRENT, PEAK};
 
 use peopletrack::Nanos;
 use peopletrack::log::msgs::{Header, Image};
 use peopletrack::log::{SessionLog, SessionWriter, WriterOptions, read_topic};
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
 
 fn write_log(path: &std::path::Path, frames: u64) {
     let mut w = SessionWriter::create(path, &WriterOptions::default()).expect("create");
@@ -61,6 +55,7 @@ fn peak_while_reading(path: &std::path::Path) -> (usize, u64) {
 
 #[test]
 fn peak_heap_is_flat_for_a_ten_times_longer_log() {
+    let _alone = crate::support::counting_alloc::alone();
     let dir = tempfile::tempdir().expect("tempdir");
     let (short, long) = (dir.path().join("short.mcap"), dir.path().join("long.mcap"));
     write_log(&short, 150);

@@ -6,17 +6,11 @@
 //! metric, per row, with 100 people per frame stays within a small budget, and does not grow
 //! with the number of people per frame.
 
-#[path = "support/counting_alloc.rs"]
-mod counting_alloc;
-
 use std::sync::atomic::Ordering::Relaxed;
 
-use counting_alloc::{CURRENT, Counting, PEAK};
+use crate::support::counting_alloc::{CURRENT, PEAK};
 
 use peopletrack::eval::mot::{BoxPx, Geometry, MatchRule, Observation, Sequence};
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
 
 /// `people` side by side for `frames` frames; the hypothesis is the ground truth shifted by
 /// 4 px (IoU 36/44 with 40 × 90 boxes), with its own ids.
@@ -54,6 +48,7 @@ fn peak_of_metrics(gt: &[Observation], hyp: &[Observation]) -> (usize, f64, f64)
 
 #[test]
 fn metrics_memory_grows_with_rows_not_with_pairs_per_frame() {
+    let _alone = crate::support::counting_alloc::alone();
     // the same 20,000 rows per side, as 2,000 frames of 10 people and 200 frames of 100
     let mut per_row = Vec::new();
     for (frames, people) in [(2_000, 10), (200, 100)] {

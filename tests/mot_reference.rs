@@ -11,7 +11,7 @@
 //!   in the files, similarity from TrackEval's `_calculate_box_ious(..., 'xywh')`, no
 //!   MOTChallenge preprocessing), means over α printed to 12 decimals; compared to 1e-9.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -2,7 +2,7 @@
 //! no-return markers, the custom `leg_tracker/msg/Person` type and TF, as recorded in each
 //! folder's `verify.txt` under `../shared/real/laser/`.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 

@@ -9,7 +9,7 @@
 //! The session is 12 s of the scenario's quick profile (one session) so the debug build stays
 //! fast on a 2-core CI machine; `make eval` runs the whole quick dataset.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

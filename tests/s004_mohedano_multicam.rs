@@ -14,7 +14,7 @@
 //! person-frames, and with the calibrated box head 19 (MOTA 0.946; 0.981 over 12 s, 0.977 on
 //! the whole quick dataset).
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! `peopletrack score` end to end: TUD-Campus (real data), bad files and bad usage as exit
 //! codes.
 
-mod common;
+use crate::common;
 
 use assert_cmd::Command;
 

@@ -5,7 +5,7 @@
 //! byte-identical to the unsharded run's, every cached session is there with the same key, and
 //! a missing shard is named by the aggregate.
 
-mod common;
+use crate::common;
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};

@@ -6,7 +6,7 @@
 //! SKIPPED (with the reason) when Slurm's daemons are not installed; `.ci/run` installs the
 //! Debian packages `slurmctld slurmd slurm-client munge`, so CI runs it.
 
-mod common;
+use crate::common;
 
 use std::net::TcpListener;
 use std::path::{Path, PathBuf};

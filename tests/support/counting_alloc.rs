@@ -1,10 +1,11 @@
-//! A counting global allocator for the memory tests (exact and deterministic, unlike RSS): each
-//! test binary that includes this file with `#[path]` installs it with
-//! `#[global_allocator] static GLOBAL: Counting = Counting;` and reads [`CURRENT`] and
-//! [`PEAK`] (bytes).
+//! A counting global allocator for the memory tests (exact and deterministic, unlike RSS): the
+//! `memory_bounds` test binary installs it with `#[global_allocator]` and its tests read
+//! [`CURRENT`] and [`PEAK`] (bytes), each holding [`alone`] so that no other test of the binary
+//! allocates while it measures.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+use std::sync::{Mutex, MutexGuard};
 
 pub struct Counting;
 pub static CURRENT: AtomicUsize = AtomicUsize::new(0);
@@ -23,4 +24,14 @@ unsafe impl GlobalAlloc for Counting {
         unsafe { System.dealloc(ptr, layout) };
         CURRENT.fetch_sub(layout.size(), Relaxed);
     }
+}
+
+static SERIAL: Mutex<()> = Mutex::new(());
+
+/// Held for the whole of a measuring test: the counters are process-wide, so the tests of this
+/// binary run one at a time (a test that panicked leaves the lock poisoned, not unusable).
+pub fn alone() -> MutexGuard<'static, ()> {
+    SERIAL
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
