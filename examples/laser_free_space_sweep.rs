@@ -11,8 +11,13 @@
 //!    `laser_people` pipeline scores synthetic sessions (CLEAR MOT at 0.75 m, 180° in front,
 //!    5 m). Prints MOTA, MOTP, FP, FN and ID switches summed per dataset.
 //!
-//! Usage: `cargo run --release --example laser_free_space_sweep [-- DATASET …]` (default: the
-//! three synthetic datasets; their quick-profile logs must exist).
+//! Usage: `cargo run --release --example laser_free_space_sweep [-- [--match-only]
+//! [--outdoor-sensor] [--default-trackers] DATASET …]` (default: the three synthetic datasets;
+//! their quick-profile logs must exist; `--match-only` stops after part 1; `--outdoor-sensor`
+//! cuts the synthetic scans to the outdoor real log's scanner, 5.6 m and −34.5°..+51.3°, from
+//! its README; `--default-trackers` tracks with leg_tracker's rule and the default quick rule
+//! only). Part 2 tracks on the true pose, on the default matcher's odometry, and in the laser
+//! frame (every pose the identity).
 
 use nalgebra::{Isometry3, Point2, Point3};
 use peopletrack::eval::mot::{Geometry, GroundPoint, MatchRule, Observation, evaluate};
@@ -46,7 +51,30 @@ fn scored(p: &Point2<f64>) -> bool {
     p.x >= 0.0 && p.coords.norm() <= 5.0
 }
 
-fn load(path: &str) -> Res<Vec<Scan>> {
+/// `--outdoor-sensor`: the synthetic scans cut to what `person_following_outdoor_1`'s scanner
+/// sees, from its README's sensor facts only (range_max 5.6 m, beams −34.5°..+51.3°): returns
+/// beyond either become +inf (no return), as that scanner reports them.
+#[derive(Clone, Copy)]
+struct Cut {
+    range_max: f64,
+    bearing_deg: (f64, f64),
+}
+
+const OUTDOOR_SENSOR: Cut = Cut {
+    range_max: 5.6,
+    bearing_deg: (-34.5, 51.3),
+};
+
+fn cut(ranges: &mut [f32], g: &ScanGeometry, c: Cut) {
+    for (k, r) in ranges.iter_mut().enumerate() {
+        let bearing = (g.angle_min + k as f64 * g.angle_increment).to_degrees();
+        if f64::from(*r) > c.range_max || bearing < c.bearing_deg.0 || bearing > c.bearing_deg.1 {
+            *r = f32::INFINITY;
+        }
+    }
+}
+
+fn load(path: &str, sensor: Option<Cut>) -> Res<Vec<Scan>> {
     let log = SessionLog::open(path)?;
     let (gt, _) = truth::people(&log, "/ground_truth/people")?;
     let options = LaserOptions {
@@ -68,10 +96,15 @@ fn load(path: &str) -> Res<Vec<Scan>> {
                     .collect()
             })
             .unwrap_or_default();
+        let geometry = ScanGeometry::of(&f.scan);
+        let mut ranges = f.scan.ranges.clone();
+        if let Some(c) = sensor {
+            cut(&mut ranges, &geometry, c);
+        }
         out.push(Scan {
             time_s: f.stamp.signed_sub(t0) as f64 * 1e-9,
-            geometry: ScanGeometry::of(&f.scan),
-            ranges: f.scan.ranges.clone(),
+            geometry,
+            ranges,
             truth,
             pose,
         });
@@ -111,6 +144,16 @@ fn odometry(scans: &[Scan], p: MatchParams) -> (Vec<Isometry3<f64>>, f64, f64, u
     }
     let n = f64::from(n.max(1));
     (est, et / n, er / n, odo.failures())
+}
+
+/// Where the tracker's poses come from: the log's true pose, scan-matched odometry (the
+/// default `MatchParams`), or none (every pose the identity: tracking in the laser frame, as
+/// leg_tracker's own launch file runs the outdoor log).
+#[derive(Clone, Copy)]
+enum Source {
+    Truth,
+    Matched,
+    Laser,
 }
 
 fn point(frame: i64, id: i64, p: Point2<f64>) -> Observation {
@@ -163,43 +206,113 @@ fn track(scans: &[Scan], poses: &[Isometry3<f64>], params: JointParams) -> Res<[
 }
 
 fn main() -> Res<()> {
-    let mut sets: Vec<String> = std::env::args().skip(1).collect();
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let match_only = args.iter().any(|a| a == "--match-only");
+    let default_trackers = args.iter().any(|a| a == "--default-trackers");
+    let sensor = args
+        .iter()
+        .any(|a| a == "--outdoor-sensor")
+        .then_some(OUTDOOR_SENSOR);
+    let mut sets: Vec<String> = args.into_iter().filter(|a| !a.starts_with("--")).collect();
     if sets.is_empty() {
         sets = ["segway_park", "laser_clutter", "office_network"]
             .map(String::from)
             .to_vec();
     }
     let base = MatchParams::default();
+    // Round 2's values (issue 35); the variants below change them one or two at a time.
+    let round2 = MatchParams {
+        max_range_m: 8.0,
+        min_points: 20,
+        small_segment_m: 0.5,
+        ..base
+    };
     let matchers: Vec<(&str, MatchParams)> = vec![
         ("default", base),
+        ("round 2", round2),
         (
             "legs only masked",
             MatchParams {
                 small_segment_m: 0.0,
-                ..base
+                ..round2
             },
         ),
         (
             "small < 1.0 m",
             MatchParams {
                 small_segment_m: 1.0,
-                ..base
+                ..round2
             },
         ),
         (
             "corr 0.5 m",
             MatchParams {
                 max_correspondence_m: 0.5,
-                ..base
+                ..round2
             },
         ),
-        ("trim 0.95", MatchParams { trim: 0.95, ..base }),
+        (
+            "trim 0.95",
+            MatchParams {
+                trim: 0.95,
+                ..round2
+            },
+        ),
+        (
+            "range 20 m",
+            MatchParams {
+                max_range_m: 20.0,
+                ..round2
+            },
+        ),
+        (
+            "legs only, 20 m",
+            MatchParams {
+                small_segment_m: 0.0,
+                max_range_m: 20.0,
+                ..round2
+            },
+        ),
+        (
+            "legs only, 20 m, 10 pts",
+            MatchParams {
+                small_segment_m: 0.0,
+                max_range_m: 20.0,
+                min_points: 10,
+                ..round2
+            },
+        ),
+        (
+            "legs only, 10 pts",
+            MatchParams {
+                small_segment_m: 0.0,
+                min_points: 10,
+                ..round2
+            },
+        ),
+        (
+            "legs only, 20 m, 6 pts",
+            MatchParams {
+                small_segment_m: 0.0,
+                max_range_m: 20.0,
+                min_points: 6,
+                ..round2
+            },
+        ),
+        (
+            "legs only, 30 m",
+            MatchParams {
+                small_segment_m: 0.0,
+                max_range_m: 30.0,
+                ..round2
+            },
+        ),
         (
             "keyframe 0.1 m",
             MatchParams {
                 keyframe_m: 0.1,
                 keyframe_rad: 0.05,
-                ..base
+                ..round2
             },
         ),
     ];
@@ -210,19 +323,22 @@ fn main() -> Res<()> {
         }),
         ..JointParams::leg_tracker()
     };
-    let trackers: Vec<(String, JointParams)> = vec![
+    let mut trackers: Vec<(String, JointParams)> = vec![
         ("leg_tracker".into(), JointParams::leg_tracker()),
         ("quick 0.25 m, 3".into(), JointParams::default()),
         ("quick 0.15 m, 3".into(), quick(0.15, 3.0)),
         ("quick 0.4 m, 3".into(), quick(0.4, 3.0)),
         ("quick 0.25 m, 6".into(), quick(0.25, 6.0)),
     ];
+    if default_trackers {
+        trackers.truncate(2);
+    }
     for set in &sets {
         let mut logs: Vec<Vec<Scan>> = Vec::new();
         for k in 0..6 {
             let path = format!("datasets/{set}/{set}_0{k}.mcap");
             if std::path::Path::new(&path).exists() {
-                logs.push(load(&path)?);
+                logs.push(load(&path, sensor)?);
             }
         }
         println!("== {set}: {} sessions", logs.len());
@@ -240,12 +356,24 @@ fn main() -> Res<()> {
             }
             println!("  scan match {name:<18} RPE(1 s) {t:.4} m {r:.3} deg, failures {f}");
         }
+        if match_only {
+            continue;
+        }
         for (name, p) in &trackers {
-            for (label, on_truth) in [("true pose", true), ("scan-matched", false)] {
+            for (label, source) in [
+                ("true pose", Source::Truth),
+                ("scan-matched", Source::Matched),
+                ("laser frame", Source::Laser),
+            ] {
                 let mut sum = [0.0; 6];
                 for (s, est) in logs.iter().zip(&matched) {
                     let truth: Vec<Isometry3<f64>> = s.iter().map(|x| x.pose).collect();
-                    let poses = if on_truth { &truth } else { est };
+                    let laser = vec![Isometry3::identity(); s.len()];
+                    let poses = match source {
+                        Source::Truth => &truth,
+                        Source::Matched => est,
+                        Source::Laser => &laser,
+                    };
                     let r = track(s, poses, *p)?;
                     for k in 0..6 {
                         sum[k] += r[k];

@@ -107,6 +107,11 @@ fn person_msg(id: u32, c: [f64; 2]) -> Value {
 /// have it (`leg_tracker/msg/Person` in the laser frame, logged between a scan and the next,
 /// no TF).
 fn write_log(path: &Path, leigh_style: bool) {
+    write_log_with(path, leigh_style, None);
+}
+
+/// [`write_log`], with a straight wall across the scan at `x = wall_x` (m) when given.
+fn write_log_with(path: &Path, leigh_style: bool, wall_x: Option<f64>) {
     let mut w = SessionWriter::create(path, &WriterOptions::default()).expect("create");
     let tf = w.add_ros2::<TfMessage>("/tf_static").expect("tf");
     let scan = w.add_ros2::<LaserScan>("/scan").expect("scan");
@@ -142,7 +147,13 @@ fn write_log(path: &Path, leigh_style: bool) {
         let t = Nanos(1_000_000_000 + i * 100_000_000);
         let circles: Vec<[f64; 2]> = (0..2).flat_map(|k| legs(centre(k, i))).collect();
         let ranges = (0..BEAMS)
-            .map(|b| ray(ANGLE_MIN + b as f64 * INCREMENT, &circles))
+            .map(|b| {
+                let a = ANGLE_MIN + b as f64 * INCREMENT;
+                let wall = wall_x
+                    .filter(|_| a.cos() > 0.2)
+                    .map_or(f32::INFINITY, |x| (x / a.cos()) as f32);
+                ray(a, &circles).min(wall)
+            })
             .collect();
         let msg = LaserScan {
             header: Header::new(t, "laser"),
@@ -378,6 +389,55 @@ fn leg_tracker_annotations_score_the_same() {
     assert_eq!(sessions[0]["gt_kind"], "leg_tracker");
     assert_eq!(sessions[0]["fixed_frame"], "laser");
     assert_eq!(sessions[0]["gt_rows"], "20");
+}
+
+/// A log without `odom`/`map` (the outdoor real log's case): the fixed frame is the scan's own
+/// frame and every TF pose the identity, which says nothing about motion. With a wall in view
+/// the free-space methods run on scan-matched odometry (`odometry = scan_match`, no failed
+/// match); with only the walkers' legs (masked out) every match fails, more than
+/// `MAX_FAILED_SHARE`, and they stay in the laser frame (`none_scan_match_unfit`, 9 failed: all
+/// but the first scan, which only becomes the keyframe). The other methods keep the laser frame and their exact scores either way. Before
+/// the fix the identity poses were taken as odometry and scan matching never ran on such logs.
+#[test]
+fn a_log_in_the_sensor_frame_gets_scan_matched_odometry_where_it_is_fit() {
+    for (wall, odometry, failures) in [
+        (Some(6.0), "scan_match", "0"),
+        (None, "none_scan_match_unfit", "9"),
+    ] {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let data = dir.path().join("leigh");
+        std::fs::create_dir_all(&data).expect("mkdir");
+        write_log_with(&data.join("leigh_walkers.mcap"), true, wall);
+        let toml = dir.path().join("laser_people.toml");
+        let listed = "\n[[params.sequences]]\nname = \"leigh_walkers\"\nscan_topic = \"/scan\"\ngt_topic = \"/ground_truth_people_tracks\"\nscans = [2, 9]\nwedge_deg = [-90.0, 90.0]\n";
+        let pipeline = PIPELINE.replace(
+            "[inputs]",
+            "[params]\nmethods = [\"legs\", \"legs_free_space\"]\n\n[inputs]",
+        );
+        std::fs::write(&toml, format!("{pipeline}{listed}")).expect("write pipeline");
+        let out = dir.path().join("out");
+        let sessions = vec![format!("{}/*.mcap", data.display())];
+        let summary = run_file(&toml, &options(&out, sessions)).expect("runs");
+        assert!(summary.skipped.is_empty(), "{:?}", summary.skipped);
+        let sessions = csv_rows(&out.join("laser_people/tables/sessions.csv"));
+        assert_eq!(sessions[0]["fixed_frame"], "laser");
+        assert_eq!(
+            (
+                &*sessions[0]["odometry"],
+                &*sessions[0]["scan_match_failures"]
+            ),
+            (odometry, failures),
+            "wall {wall:?}"
+        );
+        let rows = csv_rows(&out.join("laser_people/tables/results.csv"));
+        let legs = row(&rows, "leigh_walkers", "legs");
+        assert_eq!(
+            legs["mota"].parse::<f64>().expect("mota"),
+            1.0,
+            "wall {wall:?}"
+        );
+        row(&rows, "leigh_walkers", "legs_free_space");
+    }
 }
 
 /// `--write-tracks`: a copy of the two-walker log with one MarkerArray per scan and method on

@@ -40,7 +40,7 @@ pub struct LaserPeople;
 
 impl Experiment for LaserPeople {
     const KIND: &'static str = "laser_people";
-    const VERSION: u32 = 5;
+    const VERSION: u32 = 6;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

@@ -20,7 +20,7 @@ use super::tables::{self, ScanRow, SessionRow, TrackRow, TruthRow};
 use super::view;
 use crate::frames::laser::{self as laser_frames, LaserFrame, LaserOptions};
 use crate::frames::{Skips, truth};
-use crate::laser::scan_match::{MatchParams, Pose2, ScanOdometry, static_mask};
+use crate::laser::scan_match::{MAX_FAILED_SHARE, MatchParams, Pose2, ScanOdometry, static_mask};
 use crate::log::SessionLog;
 use crate::log::decode::carries;
 use crate::progress::Progress;
@@ -69,25 +69,31 @@ struct Collected {
 }
 
 /// The free-space methods' pose source for a session: the log's TF where the sequence lets
-/// the methods see it and the scan has it, else scan matching (only when a free-space method
-/// runs); with, for the sessions whose TF was withheld, the true and matched poses by time
-/// for the relative pose error.
+/// the methods see it, the scan has a pose and that pose is motion (the fixed frame is not the
+/// scan's own frame), else scan matching (only when a free-space method runs); with, for the
+/// sessions whose TF was withheld, the true and matched poses by time for the relative pose
+/// error.
 struct Odometry {
     matcher: Option<ScanOdometry>,
     withhold: bool,
+    /// The fixed frame is the scan's own frame (a log without `odom`/`map`): every TF pose is
+    /// the identity, which says nothing about motion, so the free-space methods scan-match.
+    sensor_frame: bool,
     /// (time s, true pose, matched pose).
     trace: Vec<(f64, Pose2, Pose2)>,
 }
 
 impl Odometry {
     fn pose(&mut self, f: &LaserFrame, view: &ScanView, time_s: f64) -> Option<Isometry3<f64>> {
-        if let (false, Some(p)) = (self.withhold, f.pose) {
+        if let (false, false, Some(p)) = (self.withhold, self.sensor_frame, f.pose) {
             return Some(p);
         }
-        let m = self.matcher.as_mut()?;
+        let Some(m) = self.matcher.as_mut() else {
+            return f.pose.filter(|_| !self.withhold);
+        };
         let keep = static_mask(&view.points, &view.segments, &view.geometric, &m.params);
         let est = m.step(&view.points, &keep);
-        if let Some(truth) = f.pose {
+        if let Some(truth) = f.pose.filter(|_| !self.sensor_frame) {
             self.trace
                 .push((time_s, Pose2::of(&truth), Pose2::of(&est)));
         }
@@ -119,6 +125,38 @@ impl Odometry {
             (sum.0 / sum.2 as f64, sum.1 / sum.2 as f64)
         }
     }
+}
+
+/// For a log whose fixed frame is the scan's own frame (no odometry): whether scan matching
+/// is fit to give the free-space methods their odometry — a first pass over the scans, failing
+/// on at most [`MAX_FAILED_SHARE`] of them — with the failures and scans counted. `None` when
+/// the log has a fixed frame of its own (its TF is the odometry).
+fn scan_match_fit(
+    log: &SessionLog,
+    topic: &str,
+    options: &LaserOptions,
+) -> anyhow::Result<Option<(bool, u64, u64)>> {
+    let mut frames = laser_frames::scans(log, topic, options)?;
+    let mut matcher = ScanOdometry::new(MatchParams::default());
+    let mut scans = 0u64;
+    while let Some(f) = frames.next() {
+        let f = f?;
+        if frames.fixed_frame() != Some(f.frame.as_str()) {
+            return Ok(None);
+        }
+        let view = ScanView::new(&f, None);
+        let keep = static_mask(
+            &view.points,
+            &view.segments,
+            &view.geometric,
+            &matcher.params,
+        );
+        matcher.step(&view.points, &keep);
+        scans += 1;
+    }
+    let failed = matcher.failures();
+    let fit = scans > 0 && failed as f64 <= MAX_FAILED_SHARE * scans as f64;
+    Ok(Some((fit, failed, scans)))
 }
 
 /// Window of the relative pose error (s).
@@ -263,13 +301,16 @@ pub(super) fn process(
             runners.push((m, r));
         }
     }
+    let free_space = p.methods.iter().any(|m| m.free_space());
+    let fit = if free_space && !seq.withhold_odometry {
+        scan_match_fit(log, &seq.scan_topic, &options)?
+    } else {
+        None
+    };
     let mut odometry = Odometry {
-        matcher: p
-            .methods
-            .iter()
-            .any(|m| m.free_space())
-            .then(|| ScanOdometry::new(MatchParams::default())),
+        matcher: free_space.then(|| ScanOdometry::new(MatchParams::default())),
         withhold: seq.withhold_odometry,
+        sensor_frame: false,
         trace: Vec::new(),
     };
     let mut out = Collected {
@@ -277,8 +318,11 @@ pub(super) fn process(
         ..Collected::default()
     };
     let mut first: Option<Nanos> = None;
-    for (idx, f) in frames.by_ref().enumerate() {
+    let mut idx = 0usize;
+    while let Some(f) = frames.next() {
         let f = f?;
+        odometry.sensor_frame =
+            matches!(fit, Some((true, ..))) && frames.fixed_frame() == Some(f.frame.as_str());
         let t0 = *first.get_or_insert(f.stamp);
         let time_s = f.stamp.signed_sub(t0) as f64 * 1e-9;
         let gt = (kind == GtKind::Synthetic)
@@ -292,6 +336,7 @@ pub(super) fn process(
             gt,
             &mut out,
         );
+        idx += 1;
         bar.inc(1);
     }
     let fixed_frame = frames.fixed_frame().unwrap_or_default().to_string();
@@ -303,18 +348,22 @@ pub(super) fn process(
         place_leg_tracker(&rows, &mut out);
     }
     let (rpe_m, rpe_deg) = odometry.rpe();
-    let matched = odometry
-        .matcher
-        .as_ref()
-        .filter(|_| odometry.withhold || out.scans.iter().any(|s| !s.posed));
+    let matched = odometry.matcher.as_ref().filter(|_| {
+        odometry.withhold || odometry.sensor_frame || out.scans.iter().any(|s| !s.posed)
+    });
+    let unfit = fit.filter(|(ok, ..)| !ok);
     let session = SessionRow {
-        odometry: if matched.is_some() {
-            "scan_match"
-        } else {
-            "tf"
+        odometry: match (matched, unfit) {
+            (Some(_), _) => "scan_match",
+            (None, Some(_)) => "none_scan_match_unfit",
+            (None, None) => "tf",
         }
         .into(),
-        scan_match_failures: matched.map_or(0, |m| m.failures() as i64),
+        scan_match_failures: match (matched, unfit) {
+            (Some(m), _) => m.failures() as i64,
+            (None, Some((_, failed, _))) => failed as i64,
+            (None, None) => 0,
+        },
         odometry_rpe_m: rpe_m,
         odometry_rpe_deg: rpe_deg,
         scan_topic: seq.scan_topic.clone(),

@@ -26,10 +26,14 @@ table_row! {
         pub scans: i64,
         /// Scans TF could not place (tracked in the sensor frame).
         pub unposed: i64,
-        /// The free-space methods' fixed frame: `tf` (the log's) or `scan_match`
-        /// ([`crate::laser::scan_match`]: no TF, or the sequence withholds it).
+        /// The free-space methods' fixed frame: `tf` (the log's), `scan_match`
+        /// ([`crate::laser::scan_match`]: no TF or only the sensor's own frame, or the
+        /// sequence withholds it), or `none_scan_match_unfit` (no odometry and the matcher
+        /// failed on more than [`crate::laser::scan_match::MAX_FAILED_SHARE`] of the scans:
+        /// they track in the laser frame).
         pub odometry: String,
-        /// Scans the scan matcher could not match (they took its prediction).
+        /// Scans the scan matcher could not match (they took its prediction; for
+        /// `none_scan_match_unfit`, the first pass's failures).
         pub scan_match_failures: i64,
         /// Where the log's TF was withheld: the scan-matched odometry's mean relative pose
         /// error over 1 s windows against TF (m, degrees); NaN otherwise.
