@@ -91,8 +91,9 @@ fn two_runs_into_one_folder_give_a_clean_runs_tables_or_one_fails_at_once() {
                 refused += 1;
                 let other = ids[1 - i];
                 let said = format!(
-                    "error: {} is in use by another run (process {other}, holding {}): ",
+                    "error: {} is in use by another run (process {other} on {}, holding {}): ",
                     folder.display(),
+                    peopletrack::run::lock::host_name(),
                     folder.join(".lock").display()
                 );
                 assert_eq!(o.status.code(), Some(1), "round {round}: {stderr}");
@@ -162,7 +163,7 @@ fn a_held_folder_names_its_holder_and_a_killed_runs_scratch_is_swept() {
         format!(
             "error: {} is in use by another run (process {}, holding {}): wait for it to finish, or give this run another --out",
             folder.display(),
-            std::process::id(),
+            peopletrack::run::lock::holder_id(),
             folder.join(".lock").display()
         )
     );

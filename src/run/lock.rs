@@ -1,14 +1,16 @@
 //! The advisory lock on an output folder whose products (tables, figures, REPORT.md) one run
 //! writes: `out/<pipeline>/.lock` for a run that aggregates (a full run or
 //! `--aggregate-only`), `out/.lock` for `peopletrack eval`. A second run into a folder in use
-//! fails at once, naming the folder and the other run's process id; runs that write disjoint
+//! fails at once, naming the folder and the other run's process id and host; runs that write disjoint
 //! things (the shards of one pipeline, which only store sessions, and runs of different
 //! pipelines) take no common lock and go on side by side.
 //!
 //! The lock is `std::fs::File::try_lock` (`flock` on Unix; on NFS, Linux maps it to a POSIX
 //! lock the server knows, so it holds across machines), released by the kernel when the
 //! process ends, however it ends: a killed run leaves no stale lock. The holder writes its
-//! process id into the lock file while it holds a short-lived second lock (`.lock.guard`),
+//! process id and host name ([`holder_id`]: `4242 on node07`; a process id alone is ambiguous
+//! when shards of a cluster share the folder) into the lock file while it holds a short-lived
+//! second lock (`.lock.guard`),
 //! under which a run that finds the folder in use reads it, so the id it reports is always
 //! complete. Where the file system has no locks the run goes on unexcluded and says so.
 
@@ -23,6 +25,22 @@ pub const LOCK_FILE: &str = ".lock";
 /// The short-lived lock taken while the holder's id is written or read.
 const GUARD_FILE: &str = ".lock.guard";
 
+/// This machine's host name: the kernel's (`/proc/sys/kernel/hostname`), else `$HOSTNAME`,
+/// else `an unknown host`. Read by hand: one file, no crate needed.
+pub fn host_name() -> String {
+    fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map(|h| h.trim().to_string())
+        .filter(|h| !h.is_empty())
+        .unwrap_or_else(|| "an unknown host".to_string())
+}
+
+/// What a holder writes into its lock file: `<process id> on <host>`.
+pub fn holder_id() -> String {
+    format!("{} on {}", std::process::id(), host_name())
+}
+
 /// Why a folder could not be locked.
 #[derive(Debug, thiserror::Error)]
 pub enum LockError {
@@ -34,7 +52,7 @@ pub enum LockError {
     InUse {
         folder: PathBuf,
         lock: PathBuf,
-        /// The holder's process id as its lock file says it.
+        /// The holder's process id and host as its lock file says them ([`holder_id`]).
         holder: String,
     },
     /// The lock file could not be made or locked (the message names the path).
@@ -92,10 +110,10 @@ impl FolderLock {
         let mut file = open_rw(&lock_path).map_err(io)?;
         match file.try_lock() {
             Ok(()) => {
-                let pid = std::process::id().to_string();
+                let holder = holder_id();
                 file.set_len(0)
                     .and_then(|()| file.rewind())
-                    .and_then(|()| file.write_all(format!("{pid}\n").as_bytes()))
+                    .and_then(|()| file.write_all(format!("{holder}\n").as_bytes()))
                     .map_err(at("writing lock file", &lock_path))
                     .map_err(io)?;
                 drop(guard);
@@ -137,7 +155,7 @@ mod tests {
             format!(
                 "{} is in use by another run (process {}, holding {}): wait for it to finish, or give this run another --out",
                 folder.display(),
-                std::process::id(),
+                holder_id(),
                 folder.join(LOCK_FILE).display()
             )
         );
