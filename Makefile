@@ -4,8 +4,10 @@ PYTHON ?= python3
 VENV := target/py-venv
 # py-motmetrics needs numpy 1, OpenCV 4.12 numpy 2: separate throwaway environments
 VENV_MOT := target/py-venv-mot
+# the notebook guide's readers (docs/notebooks.md)
+VENV_NB := target/py-venv-notebook
 
-.PHONY: help eval datasets release test bench interop audio-interop clean opencv-agreement stonesoup-agreement bench-gmm bench-multicam bench-laser wildtrack
+.PHONY: help eval datasets release test bench interop notebook-check audio-interop clean opencv-agreement stonesoup-agreement bench-gmm bench-multicam bench-laser wildtrack
 
 PROFILE ?= quick
 
@@ -17,6 +19,7 @@ help:
 	@echo "make bench     criterion benchmarks + the same reads in Python mcap-ros2-support, with ratios"
 	@echo "make bench-mot tracking metrics: criterion on a synthetic sequence + py-motmetrics on the same files, with the ratio"
 	@echo "make interop   check that Python mcap-ros2-support opens what we write, synthetic datasets included (throwaway venv)"
+	@echo "make notebook-check  run docs/notebooks.md's Python (polars, pandas, DuckDB) against a fresh dataset_quality run (throwaway venv)"
 	@echo "make audio-interop  read the BIRON audio back with Python mcap-ros2-support: a fixture and a biron_home session, samples equal (throwaway venv)"
 	@echo "make opencv-agreement  pixel agreement of vision::gmm masks with OpenCV MOG2, fails below 100 % (throwaway venv)"
 	@echo "make stonesoup-agreement  seed 001's PDAF (CV, CT) and IMM step by step against Stone Soup on real and synthetic scans, fails above 1e-9 (throwaway venv)"
@@ -62,6 +65,18 @@ interop: $(VENV)/ok
 	$(VENV)/bin/python tools/check_mcap_ros2.py target/interop/fixture.mcap target/interop/expected.json
 	$(MAKE) datasets
 	$(VENV)/bin/python tools/check_synth_ros2.py ./target/release/peopletrack datasets/*/*.mcap
+
+# Issue 34: the notebook guide's code, block by block, against a fresh run of dataset_quality
+# (hive-style per-session cache: out/<pipeline>/sessions/dataset=<d>/session=<s>/).
+$(VENV_NB)/ok:
+	$(PYTHON) -m venv $(VENV_NB)
+	$(VENV_NB)/bin/pip install --quiet --disable-pip-version-check polars==1.44.2 pandas==2.3.3 pyarrow==26.0.1 duckdb==1.5.6
+	touch $@
+
+notebook-check: $(VENV_NB)/ok datasets
+	rm -rf target/notebook-out
+	./target/release/peopletrack run pipelines/dataset_quality.toml --out target/notebook-out
+	$(VENV_NB)/bin/python tools/check_notebook_guide.py docs/notebooks.md target/notebook-out
 
 # Issue 33: the two-microphone audio (audio_common_msgs) read back by mcap-ros2-support, sample
 # for sample: a fixture of known samples, then a biron_home session against its `peopletrack wav`.

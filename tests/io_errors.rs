@@ -91,12 +91,12 @@ fn a_session_computed_but_not_stored_fails_the_run_and_is_listed() {
     assert_eq!(run(&clean, &sessions, &[]).0, Some(0));
     // the cache folder of dataset `lab` cannot be made: a file is in the way
     let out = dir.path().join("out");
-    let blocked = out.join("dataset_quality/sessions/lab");
+    let blocked = out.join("dataset_quality/sessions/dataset=lab");
     std::fs::create_dir_all(blocked.parent().expect("parent")).expect("mkdir");
     std::fs::write(&blocked, b"in the way").expect("write");
     let (code, _, stderr) = run(&out, &sessions, &[]);
     assert_eq!(code, Some(1), "{stderr}");
-    let cache_a = blocked.join("a");
+    let cache_a = blocked.join("session=a");
     let reason = format!(
         "computed, but its results could not be stored in the cache at {}: creating folder {}: File exists (os error 17)",
         cache_a.display(),

@@ -647,7 +647,7 @@ fn real_general_tracking_moving_1_completes() {
     assert!(r["status"].starts_with("SKIPPED"));
     // the annotations sit on the scans the authors' ground_truth.csv names
     let cached = out.join(
-        "laser_people/sessions/general_tracking_moving_1/general_tracking_moving_1/truth.parquet",
+        "laser_people/sessions/dataset=general_tracking_moving_1/session=general_tracking_moving_1/truth.parquet",
     );
     let df = read_parquet(&cached).expect("cached truth");
     let ours: Vec<(i64, i64)> = i64s(&df, "scan_idx")

@@ -1,4 +1,6 @@
-//! The per-session Parquet cache: `out/<pipeline>/sessions/<dataset>/<session>/` holds one
+//! The per-session Parquet cache: `out/<pipeline>/sessions/dataset=<dataset>/session=<session>/`
+//! (hive-style, so that Python polars, pandas/pyarrow and DuckDB read every session of a table
+//! with `dataset` and `session` columns from the path: `docs/notebooks.md`) holds one
 //! `<table>.parquet` per table, `source.txt` (the log's hash and path) and `key.txt`, written
 //! last. The key hashes the log's bytes, the experiment's kind and `VERSION`, the tool version,
 //! the parameters and the topic remaps (and `--recover` and a structure limit set by
@@ -73,12 +75,17 @@ impl KeyParts<'_> {
     }
 }
 
+/// Prefix of a dataset's folder in the cache (hive partition key).
+pub const DATASET_KEY: &str = "dataset=";
+/// Prefix of a session's folder in the cache (hive partition key).
+pub const SESSION_KEY: &str = "session=";
+
 /// The cache folder of one session.
 pub fn session_dir(out: &Path, pipeline: &str, s: &SessionRef) -> PathBuf {
     out.join(pipeline)
         .join("sessions")
-        .join(&s.dataset)
-        .join(&s.name)
+        .join(format!("{DATASET_KEY}{}", s.dataset))
+        .join(format!("{SESSION_KEY}{}", s.name))
 }
 
 /// Cached tables and the log's reading warnings if the stored key is `key`.
@@ -234,10 +241,18 @@ pub fn cached_sessions(
         return found;
     };
     for d in datasets.flatten() {
+        let dataset = d.file_name().to_string_lossy().into_owned();
+        let Some(dataset) = dataset.strip_prefix(DATASET_KEY).map(str::to_string) else {
+            continue;
+        };
         let Ok(sessions) = std::fs::read_dir(d.path()) else {
             continue;
         };
         for s in sessions.flatten() {
+            let session = s.file_name().to_string_lossy().into_owned();
+            let Some(session) = session.strip_prefix(SESSION_KEY).map(str::to_string) else {
+                continue;
+            };
             let Ok(text) = std::fs::read_to_string(s.path().join(SOURCE_FILE)) else {
                 continue;
             };
@@ -254,12 +269,48 @@ pub fn cached_sessions(
                     .any(|e| e.matches(&file) || e.matches_path(&path));
             if selected {
                 found.push(SessionRef {
-                    dataset: d.file_name().to_string_lossy().into_owned(),
-                    name: s.file_name().to_string_lossy().into_owned(),
+                    dataset: dataset.clone(),
+                    name: session,
                     path,
                 });
             }
         }
     }
     found
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cache is hive-style (`dataset=<d>/session=<s>`), and only such folders are found
+    /// again: a folder of the earlier `<d>/<s>` layout is not a cached session.
+    #[test]
+    fn the_cache_is_hive_style_and_found_again_by_its_keys() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let out = dir.path();
+        let s = SessionRef {
+            dataset: "lab".into(),
+            name: "lab_00".into(),
+            path: PathBuf::from("/data/lab/lab_00.mcap"),
+        };
+        let hive = session_dir(out, "p", &s);
+        assert_eq!(hive, out.join("p/sessions/dataset=lab/session=lab_00"));
+        let old = out.join("p/sessions/lab/lab_01");
+        for (d, log) in [
+            (&hive, "/data/lab/lab_00.mcap"),
+            (&old, "/data/lab/lab_01.mcap"),
+        ] {
+            std::fs::create_dir_all(d).expect("mkdir");
+            std::fs::write(d.join(SOURCE_FILE), format!("{:032x}\n{log}\n", 7u128))
+                .expect("source");
+        }
+        let found = cached_sessions(out, "p", &["/data/lab/*.mcap".to_string()], &[]);
+        assert_eq!(found.len(), 1, "{found:?}");
+        assert_eq!(
+            (found[0].dataset.as_str(), found[0].name.as_str()),
+            ("lab", "lab_00")
+        );
+        assert_eq!(recorded_hash(&hive), Some(7));
+    }
 }

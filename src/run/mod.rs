@@ -3,7 +3,7 @@
 //! 1. **Plan**: parse the pipeline file, find its sessions, and say which stages read which
 //!    topics (`--dry-run` prints this and stops).
 //! 2. **Per session** (rayon over sessions): the experiment's `process` turns one log into
-//!    named tables, saved as Parquet under `out/<pipeline>/sessions/<dataset>/<session>/` with a
+//!    named tables, saved as Parquet under `out/<pipeline>/sessions/dataset=<dataset>/session=<session>/` with a
 //!    key (input file hash + parameters + experiment version). A later run with the same key
 //!    loads them instead of recomputing, so an interrupted or repeated run skips finished work.
 //!    `--shard K/N` runs only every N-th session, for array jobs on a cluster scheduler.

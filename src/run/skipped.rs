@@ -186,7 +186,9 @@ mod tests {
         assert_eq!(status("reading x.mcap: file is truncated"), "failed");
         assert_eq!(warned_status("recovered: bytes 8..90 are lost"), WARNED);
         assert_eq!(
-            warned_status(&format!("{NOT_STORED}out/p/sessions/d/s: disk full")),
+            warned_status(&format!(
+                "{NOT_STORED}out/p/sessions/dataset=d/session=s: disk full"
+            )),
             UNSTORED
         );
     }
