@@ -360,8 +360,8 @@ fn a_log_without_one_cameras_calibration_is_skipped_with_file_and_topic() {
 fn cached_tables(out: &Path, dataset: &str, name: &str) -> peopletrack::run::SessionTables {
     let dir = out
         .join("s004_mohedano_multicam/sessions")
-        .join(dataset)
-        .join(name);
+        .join(format!("dataset={dataset}"))
+        .join(format!("session={name}"));
     let mut t = peopletrack::run::SessionTables::new();
     for e in std::fs::read_dir(&dir).expect("session cache") {
         let p = e.expect("entry").path();
