@@ -195,15 +195,14 @@ fn the_closed_loop_log_is_byte_identical_on_one_and_two_threads() {
     assert!(again(2) == first, "2 threads differ from the fixture");
 }
 
-/// The real person-following log (laser only) runs when `../shared/real` is present.
+/// The real person-following log (laser only) runs when `../shared/real` is present, and the
+/// paper's configuration, laser only, is on the person on at least half of its annotated scans.
 ///
-/// Since issue 30, with σ_r = 0.6 m (derived from the paper's reset timing, `track::pdaf`)
-/// the laser-only paper configuration is on the person on 0.29 of this log's scans (0.97 with
-/// the earlier σ_r = 0.15 m; 0.87 with σ_r = 0.15 m and the new noises): the wide gate takes in
-/// the clutter beside the person and the track never resets. Open (issue 30, see
-/// docs/s001_kobilarov_following.md, "Real data"): until it is fixed this test holds the floor
-/// of a follower that starts on the person and keeps it for a while (> 0.2), not the 0.5 a
-/// working follower reaches.
+/// History (issue 30): with σ_r = 0.6 m (then derived from the paper's reset timing) it was on
+/// the person on 0.29 of the scans: the wide χ² gate took in the clutter beside the person and
+/// the track never reset. σ_r is now the measured blob-centre scatter (0.19 m) and the reset
+/// timing sets the multiplier k instead (`track::pdaf`); 0.5 is the floor of a working follower
+/// set before this run, not fitted to it.
 #[test]
 fn the_real_person_following_log_runs_laser_only() {
     let real = root()
@@ -231,5 +230,5 @@ fn the_real_person_following_log_runs_laser_only() {
     let on: f64 = paper["on_target"].parse().expect("on_target");
     eprintln!("real: {rows:?}");
     assert!(paper["annotated_scans"] == "6179", "{paper:?}");
-    assert!(on > 0.2, "on target {on}");
+    assert!(on > 0.5, "on target {on}");
 }
