@@ -190,13 +190,13 @@ mod tests {
         let o = [[0.15, 0.0], [-0.05, 0.0], [0.05, 0.2], [0.05, -0.2]];
         let r = scatter("target", &o);
         assert_eq!(r.blobs, 4);
-        assert!((r.mean_dx.unwrap() - 0.05).abs() < 1e-12);
-        assert!(r.mean_dy.unwrap().abs() < 1e-12);
+        assert!((r.mean_dx.expect("mean_dx") - 0.05).abs() < 1e-12);
+        assert!(r.mean_dy.expect("mean_dy").abs() < 1e-12);
         // sample sd: x √(0.02/3), y √(0.08/3)
-        assert!((r.sd_x.unwrap() - (0.02f64 / 3.0).sqrt()).abs() < 1e-12);
-        assert!((r.sd_y.unwrap() - (0.08f64 / 3.0).sqrt()).abs() < 1e-12);
+        assert!((r.sd_x.expect("sd_x") - (0.02f64 / 3.0).sqrt()).abs() < 1e-12);
+        assert!((r.sd_y.expect("sd_y") - (0.08f64 / 3.0).sqrt()).abs() < 1e-12);
         // Σ|d|² = 0.0225 + 0.0025 + 0.0425 + 0.0425 = 0.11; /(2·4) → √0.01375
-        assert!((r.sigma_axis.unwrap() - 0.01375f64.sqrt()).abs() < 1e-12);
+        assert!((r.sigma_axis.expect("sigma_axis") - 0.01375f64.sqrt()).abs() < 1e-12);
         assert_eq!(scatter("person", &[]).sigma_axis, None);
     }
 }
