@@ -15,6 +15,8 @@ pub fn products(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     out.tables.extend(super::table1::tables(&synthetic, p)?);
     out.tables.extend(super::compare::tables(&synthetic, p)?);
     out.tables.push(super::colour::table(&synthetic, p)?);
+    out.tables
+        .push(super::colour::scatter_table(&synthetic, p)?);
     let m1: Vec<Method1Row> = synthetic
         .iter()
         .flat_map(|d| d.method1.iter().cloned())

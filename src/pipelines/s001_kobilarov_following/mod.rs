@@ -41,7 +41,7 @@ pub struct KobilarovFollowing;
 
 impl Experiment for KobilarovFollowing {
     const KIND: &'static str = "s001_kobilarov_following";
-    const VERSION: u32 = 2;
+    const VERSION: u32 = 3;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

@@ -127,6 +127,10 @@ pub enum Method {
         update: bool,
         /// corr as printed (no square root) instead of the normalised form.
         printed: bool,
+        /// `rst` at the paper's literal "usually 5" σ_r
+        /// ([`crate::track::pdaf::RESET_SIGMAS_LITERAL`]) instead of the multiplier derived
+        /// from its reset timing (`follower.reset_sigmas`).
+        literal_rst: bool,
     },
     /// The laser issue's multi-person tracker (`laser::tracker`), its track nearest the
     /// target followed.
@@ -139,16 +143,19 @@ pub const PAPER: &str = "ct_colour";
 pub const UPDATED: &str = "ct_colour_updated";
 /// The same with corr as printed (Σ H_i H_j / (Σ H_i² Σ H_j²), no square root).
 pub const PRINTED: &str = "ct_colour_printed";
+/// The same with `rst` when √λ_max(P_xy) > 5 σ_r, the paper's "usually 5" read literally.
+pub const RST5: &str = "ct_colour_rst5";
 pub const CV: &str = "cv_colour";
 pub const IMM: &str = "imm_colour";
 pub const NO_COLOUR: &str = "ct_no_colour";
 pub const NN: &str = "nn_ct";
 pub const LASER_TRACKER: &str = "laser_tracker";
 /// Every known method, in the default table order.
-pub const METHODS: [&str; 8] = [
+pub const METHODS: [&str; 9] = [
     PAPER,
     UPDATED,
     PRINTED,
+    RST5,
     CV,
     IMM,
     NO_COLOUR,
@@ -167,6 +174,7 @@ pub fn method(name: &str) -> Option<Method> {
             colour,
             update,
             printed: false,
+            literal_rst: false,
         })
     };
     match name {
@@ -178,6 +186,15 @@ pub fn method(name: &str) -> Option<Method> {
             colour: true,
             update: false,
             printed: true,
+            literal_rst: false,
+        }),
+        RST5 => Some(Method::Follower {
+            model: Ct,
+            association: Pdaf,
+            colour: true,
+            update: false,
+            printed: false,
+            literal_rst: true,
         }),
         CV => f(Cv, Pdaf, true, false),
         IMM => f(Imm, Pdaf, true, false),

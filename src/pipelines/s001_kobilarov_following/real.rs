@@ -1,6 +1,6 @@
 //! A real laser log (Leigh et al.'s annotated person-following sequence): no camera, no
 //! odometry, so every follower runs laser only in the laser frame (colour off: a method that
-//! differs from another only by colour is run once), beside the laser issue's multi-person
+//! differs from another only by colour or corr is run once; the literal `rst` is kept), beside the laser issue's multi-person
 //! tracker. Each starts at the first annotation; every annotation belongs to the last scan
 //! logged before it (the authors' rule) and is scored against the estimate of that scan.
 
@@ -26,13 +26,17 @@ pub fn methods(p: &Params) -> Vec<(String, Method)> {
         };
         let m = match m {
             Method::Follower {
-                model, association, ..
+                model,
+                association,
+                literal_rst,
+                ..
             } => Method::Follower {
                 model,
                 association,
                 colour: false,
                 update: false,
                 printed: false,
+                literal_rst,
             },
             other => other,
         };

@@ -36,6 +36,7 @@ impl Runner {
                 colour,
                 update,
                 printed,
+                literal_rst,
             } => {
                 let mut fp = p.follower.params(model, association, colour);
                 if update {
@@ -43,6 +44,9 @@ impl Runner {
                 }
                 if printed {
                     fp.corr_form = crate::vision::cylinder::CorrForm::Printed;
+                }
+                if literal_rst {
+                    fp.filter.reset_sigmas = crate::track::pdaf::RESET_SIGMAS_LITERAL;
                 }
                 Runner::Follower(Box::new(FollowTracker::new(&fp, init)))
             }

@@ -304,10 +304,13 @@ fn step_all(
         {
             colour.extend(out.blob_corr.iter().map(|(c, corr)| {
                 let q = m * Point3::new(c[0], c[1], 0.0);
+                let (kind, offset) = blob_kind(frame, (q.x, q.y), ctx.p);
                 ColourRow {
                     scan_idx: idx,
-                    kind: blob_kind(frame, (q.x, q.y), ctx.p).into(),
+                    kind: kind.into(),
                     corr: *corr,
+                    dx: offset.map(|o| o[0]),
+                    dy: offset.map(|o| o[1]),
                 }
             }));
         }
@@ -325,18 +328,18 @@ fn step_all(
 }
 
 /// What a blob at `at` (map) is: the target, another person (within `lock_m` of their true
-/// position) or something static.
-fn blob_kind(frame: &PeopleFrame, at: (f64, f64), p: &Params) -> &'static str {
+/// position) or something static; for a person's blob, its centre minus their position.
+fn blob_kind(frame: &PeopleFrame, at: (f64, f64), p: &Params) -> (&'static str, Option<[f64; 2]>) {
     let near = frame
         .people
         .iter()
-        .map(|q| (q.id, (q.x - at.0).hypot(q.y - at.1)))
-        .filter(|(_, d)| *d <= p.lock_m)
-        .min_by(|a, b| a.1.total_cmp(&b.1));
+        .map(|q| (q.id, [at.0 - q.x, at.1 - q.y]))
+        .filter(|(_, o)| o[0].hypot(o[1]) <= p.lock_m)
+        .min_by(|a, b| a.1[0].hypot(a.1[1]).total_cmp(&b.1[0].hypot(b.1[1])));
     match near {
-        Some((id, _)) if id == p.target_id => "target",
-        Some(_) => "person",
-        None => "static",
+        Some((id, o)) if id == p.target_id => ("target", Some(o)),
+        Some((_, o)) => ("person", Some(o)),
+        None => ("static", None),
     }
 }
 

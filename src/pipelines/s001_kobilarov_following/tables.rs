@@ -110,12 +110,15 @@ table_row! {
 table_row! {
     /// One blob of one scan as the paper's configuration saw it: its normalised correlation
     /// with the template and what the ground truth says it is (`target`, `person` — another
-    /// person — or `static`: nobody within `lock_m`): `colour`.
+    /// person — or `static`: nobody within `lock_m`), and for a person's blob its centre minus
+    /// that person's true position (map frame, m): `colour`.
     #[derive(Debug, Clone, PartialEq)]
     pub struct ColourRow {
         pub scan_idx: i64,
         pub kind: String,
         pub corr: f64,
+        pub dx: Option<f64>,
+        pub dy: Option<f64>,
     }
 }
 
