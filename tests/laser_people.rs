@@ -363,6 +363,9 @@ fn learned_methods_without_training_data_are_skipped() {
     );
 }
 
+/// The hand-made Leigh-style session as a listed sequence with a scored-scan window.
+const LEIGH_SEQUENCE: &str = "\n[[params.sequences]]\nname = \"leigh_walkers\"\nscan_topic = \"/scan\"\ngt_topic = \"/ground_truth_people_tracks\"\nscans = [2, 9]\nwedge_deg = [-90.0, 90.0]\n";
+
 /// The real logs' ground-truth path on the same walkers: `leg_tracker/msg/Person` messages in
 /// the laser frame, each logged after its scan, a listed sequence with a scored-scan window, no
 /// TF (tracked in the laser frame): the same exact scores.
@@ -373,8 +376,7 @@ fn leg_tracker_annotations_score_the_same() {
     std::fs::create_dir_all(&data).expect("mkdir");
     write_log(&data.join("leigh_walkers.mcap"), true);
     let toml = dir.path().join("laser_people.toml");
-    let listed = "\n[[params.sequences]]\nname = \"leigh_walkers\"\nscan_topic = \"/scan\"\ngt_topic = \"/ground_truth_people_tracks\"\nscans = [2, 9]\nwedge_deg = [-90.0, 90.0]\n";
-    std::fs::write(&toml, format!("{PIPELINE}{listed}")).expect("write pipeline");
+    std::fs::write(&toml, format!("{PIPELINE}{LEIGH_SEQUENCE}")).expect("write pipeline");
     let out = dir.path().join("out");
     let sessions = vec![format!("{}/*.mcap", data.display())];
     let summary = run_file(&toml, &options(&out, sessions)).expect("runs");
@@ -409,12 +411,11 @@ fn a_log_in_the_sensor_frame_gets_scan_matched_odometry_where_it_is_fit() {
         std::fs::create_dir_all(&data).expect("mkdir");
         write_log_with(&data.join("leigh_walkers.mcap"), true, wall);
         let toml = dir.path().join("laser_people.toml");
-        let listed = "\n[[params.sequences]]\nname = \"leigh_walkers\"\nscan_topic = \"/scan\"\ngt_topic = \"/ground_truth_people_tracks\"\nscans = [2, 9]\nwedge_deg = [-90.0, 90.0]\n";
         let pipeline = PIPELINE.replace(
             "[inputs]",
             "[params]\nmethods = [\"legs\", \"legs_free_space\"]\n\n[inputs]",
         );
-        std::fs::write(&toml, format!("{pipeline}{listed}")).expect("write pipeline");
+        std::fs::write(&toml, format!("{pipeline}{LEIGH_SEQUENCE}")).expect("write pipeline");
         let out = dir.path().join("out");
         let sessions = vec![format!("{}/*.mcap", data.display())];
         let summary = run_file(&toml, &options(&out, sessions)).expect("runs");
