@@ -7,7 +7,7 @@ VENV_MOT := target/py-venv-mot
 # the notebook guide's readers (docs/notebooks.md)
 VENV_NB := target/py-venv-notebook
 
-.PHONY: help eval datasets release test bench interop notebook-check audio-interop clean opencv-agreement stonesoup-agreement bench-gmm bench-multicam bench-laser wildtrack
+.PHONY: help eval datasets release build-s3 test test-s3 bench interop notebook-check audio-interop clean opencv-agreement stonesoup-agreement bench-gmm bench-multicam bench-laser wildtrack
 
 PROFILE ?= quick
 
@@ -16,6 +16,8 @@ help:
 	@echo "make wildtrack import ../shared/real/wildtrack (if present) and run pipelines/real/s004_wildtrack.toml"
 	@echo "make datasets  synthesize every dataset in datasets/ whose logs are absent (PROFILE=quick|full)"
 	@echo "make test      build and run every test (the CI command)"
+	@echo "make build-s3  release build with object storage (s3:// logs and --out; docs/cluster.md)"
+	@echo "make test-s3   a pipeline end to end against a local S3 server (Garage $(GARAGE_VERSION), installed once into $(TOOLS))"
 	@echo "make bench     criterion benchmarks + the same reads in Python mcap-ros2-support, with ratios"
 	@echo "make bench-mot tracking metrics: criterion on a synthetic sequence + py-motmetrics on the same files, with the ratio"
 	@echo "make interop   check that Python mcap-ros2-support opens what we write, synthetic datasets included (throwaway venv)"
@@ -53,6 +55,19 @@ wildtrack: release
 
 test:
 	$(CARGO) test --locked
+
+build-s3:
+	$(CARGO) build --release --locked --features s3
+
+# Object storage against a real S3 server: Garage, built from crates.io once into $(TOOLS)
+# (about 21 minutes on 2 cores), then reused; tests/object_storage.rs starts it privately.
+TOOLS ?= target/tools
+GARAGE_VERSION := 2.5.0
+$(TOOLS)/bin/garage:
+	$(CARGO) install --locked garage --version $(GARAGE_VERSION) --root $(TOOLS)
+
+test-s3: $(TOOLS)/bin/garage
+	GARAGE_BIN=$(abspath $(TOOLS)/bin/garage) $(CARGO) test --locked --features s3 --test object_storage -- --nocapture
 
 # A throwaway virtual environment with the Python peers (not needed by the project itself).
 $(VENV)/ok:

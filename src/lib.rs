@@ -21,6 +21,7 @@ pub mod progress;
 pub mod report;
 pub mod rng;
 pub mod run;
+pub mod storage;
 pub mod synth;
 pub mod time;
 pub mod track;

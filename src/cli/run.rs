@@ -3,15 +3,19 @@
 
 use std::path::PathBuf;
 
+use anyhow::Context;
 use peopletrack::pipelines;
 use peopletrack::report::atomic;
-use peopletrack::run::{RunOptions, skipped, slurm};
+use peopletrack::run::{RunOptions, config, skipped, slurm};
+use peopletrack::storage::{self, mirror::Mirror};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Pipeline file, e.g. pipelines/dataset_quality.toml.
     pub pipeline: PathBuf,
-    /// Run on these sessions instead of the file's [inputs] (glob; repeat for more).
+    /// Run on these sessions instead of the file's [inputs] (glob; repeat for more). With a
+    /// build that has object storage (`make build-s3`), also `s3://bucket/prefix/*.mcap`:
+    /// the store is listed and each log read in place with range requests.
     #[arg(long, value_name = "GLOB")]
     pub sessions: Vec<String>,
     /// Print which sessions, topics and stages would run, and stop.
@@ -37,7 +41,9 @@ pub struct Args {
     /// Recompute sessions even when a cached result matches.
     #[arg(long)]
     pub force: bool,
-    /// Output root.
+    /// Output root: a folder, or (object storage build) `s3://bucket/prefix`, where the
+    /// pipeline's folder is fetched, worked on locally and written back file by file
+    /// (credentials and endpoint from AWS_* variables; docs/cluster.md).
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
     /// Write the tracks back into a copy of each log (as visualization_msgs/msg/MarkerArray,
@@ -90,6 +96,29 @@ pub fn options(a: &Args, progress: bool) -> RunOptions {
     }
 }
 
+/// `--out s3://...`: a local mirror of the pipeline's folder that the run works in
+/// ([`storage::mirror`]); `--write-tracks` below `--out` goes there too.
+fn object_store_out(a: &Args, opts: &mut RunOptions) -> anyhow::Result<Option<Mirror>> {
+    if !storage::is_url(&a.out) {
+        return Ok(None);
+    }
+    let name = config::read_name(&a.pipeline)?;
+    let url = a.out.to_string_lossy();
+    let mirror = Mirror::pull(&url, &name).with_context(|| format!("reading {url}/{name}/"))?;
+    opts.out = mirror.local().to_path_buf();
+    if let Some(dir) = &opts.write_tracks {
+        opts.write_tracks = Some(match dir.strip_prefix(&a.out) {
+            Ok(rel) => mirror.local().join(rel),
+            Err(_) if storage::is_url(dir) => anyhow::bail!(
+                "--write-tracks {}: tracks go to a local folder or below --out",
+                dir.display()
+            ),
+            Err(_) => dir.clone(),
+        });
+    }
+    Ok(Some(mirror))
+}
+
 /// How a session kept with a warning was kept (for the warning line).
 pub fn kept_how(why: &str) -> &'static str {
     if skipped::warned_status(why) == skipped::UNSTORED {
@@ -104,10 +133,23 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     if a.shard_from_env {
         opts.shard = Some(slurm::shard_from_env(|k| std::env::var(k).ok())?);
     }
+    let mirror = object_store_out(a, &mut opts)?;
     if !a.dry_run {
-        atomic::sweep_scratch(&a.out)?;
+        atomic::sweep_scratch(&opts.out)?;
     }
     let s = pipelines::run_file(&a.pipeline, &opts)?;
+    if let (Some(m), false) = (&mirror, a.dry_run) {
+        let pushed = m
+            .push()
+            .with_context(|| format!("writing to {}", a.out.display()))?;
+        eprintln!(
+            "{}: {} files written ({} bytes), {} unchanged",
+            a.out.display(),
+            pushed.files,
+            pushed.bytes,
+            pushed.unchanged
+        );
+    }
     if a.dry_run {
         write!(out, "{}", s.plan)?;
         for n in &s.notices {

@@ -10,15 +10,17 @@
 //! - `merge`: the time-ordered k-way merge of chunks behind [`MessageStream`]; chunks are
 //!   decompressed lazily and freed when consumed, equal log times keep file order.
 //! - `io`: bounded reads at an offset.
+//! - `source`: a local file or (feature `s3`) an object in a store, read with range requests:
+//!   opening fetches the footer and summary section, a stream only the chunks it needs.
 
 mod chunk;
 mod index;
 mod io;
 mod merge;
 mod records;
+mod source;
 
 use std::collections::BTreeSet;
-use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
@@ -26,6 +28,8 @@ use super::error::{LogError, LogErrorKind};
 
 pub use index::LogSummary;
 pub use merge::{Message, MessageStream, Payload};
+use source::Source;
+
 pub use records::{ChannelInfo, ChunkInfo, MetadataRecord, SchemaInfo, Statistics};
 
 /// How many of a log's chunks carry a CRC.
@@ -68,8 +72,8 @@ impl CrcCoverage {
     }
 }
 
-/// An open session log. Cheap to share; each [`SessionLog::messages`] call opens its own
-/// file handle.
+/// An open session log (a file, or an `s3://` URL with the `s3` feature). Cheap to share;
+/// each [`SessionLog::messages`] call opens its own handle.
 #[derive(Debug, Clone)]
 pub struct SessionLog {
     path: PathBuf,
@@ -78,11 +82,10 @@ pub struct SessionLog {
 
 /// The file at `path`, its length, and the read position after its MCAP magic (else
 /// [`LogErrorKind::NotMcap`]).
-fn open_mcap(path: &Path) -> Result<(PathBuf, File, u64), LogError> {
+fn open_mcap(path: &Path) -> Result<(PathBuf, Source, u64), LogError> {
     let path = path.to_path_buf();
     let err = |k: LogErrorKind| LogError::new(&path, k);
-    let mut file = File::open(&path).map_err(|e| err(e.into()))?;
-    let file_len = file.metadata().map_err(|e| err(e.into()))?.len();
+    let (mut file, file_len) = Source::open(&path).map_err(|e| err(e.into()))?;
     let mut magic = [0u8; 8];
     if file_len < 8 || file.read_exact(&mut magic).is_err() || &magic != records::MAGIC {
         return Err(err(LogErrorKind::NotMcap));
@@ -156,7 +159,7 @@ impl SessionLog {
     /// writes 0 = "not computed"). Reads each chunk's fixed header only.
     pub fn crc_coverage(&self) -> Result<CrcCoverage, LogError> {
         let err = |k: LogErrorKind| LogError::new(&self.path, k);
-        let mut file = File::open(&self.path).map_err(|e| err(e.into()))?;
+        let (mut file, _) = Source::open(&self.path).map_err(|e| err(e.into()))?;
         let mut out = CrcCoverage {
             chunks: self.summary.chunks.len(),
             with_crc: 0,
@@ -195,7 +198,7 @@ impl SessionLog {
     }
 
     fn stream(&self, topics: Option<BTreeSet<String>>) -> Result<MessageStream, LogError> {
-        let mut file = File::open(&self.path).map_err(|e| LogError::new(&self.path, e))?;
+        let (mut file, _) = Source::open(&self.path).map_err(|e| LogError::new(&self.path, e))?;
         file.seek(SeekFrom::Start(8))
             .map_err(|e| LogError::new(&self.path, e))?;
         Ok(MessageStream::new(

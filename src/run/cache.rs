@@ -27,8 +27,12 @@ const SOURCE_FILE: &str = "source.txt";
 /// The reading warnings of a session's log (recovery losses, a linear re-index), one per line.
 const WARNINGS_FILE: &str = "warnings.txt";
 
-/// Hash of a file's bytes (xxh3-128, streamed).
+/// Hash of a file's bytes (xxh3-128, streamed); of an object in a store (`s3://`), the
+/// content key [`crate::storage::RemoteObject::content_hash`] gives (its ETag and size).
 pub fn hash_file(path: &Path) -> std::io::Result<u128> {
+    if crate::storage::is_url(path) {
+        return crate::storage::RemoteObject::open(&path.to_string_lossy())?.content_hash();
+    }
     let mut f = std::fs::File::open(path)?;
     let mut h = Xxh3::new();
     let mut buf = vec![0u8; 1 << 20];

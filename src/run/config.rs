@@ -105,6 +105,7 @@ struct KindOnly {
 #[derive(Deserialize)]
 struct KindSection {
     kind: String,
+    name: Option<String>,
 }
 
 /// Read a pipeline file and return its text and `pipeline.kind`.
@@ -124,6 +125,19 @@ pub fn kind_of(path: &Path, text: &str) -> Result<String, ConfigError> {
         message: e.to_string().trim_end().to_string(),
     })?;
     Ok(k.pipeline.kind)
+}
+
+/// The `pipeline.name` of a pipeline file (the folder below `--out` that it writes).
+pub fn read_name(path: &Path) -> Result<String, ConfigError> {
+    let text = std::fs::read_to_string(path).map_err(|error| ConfigError::Read {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    let k: KindOnly = toml::from_str(&text).map_err(|e| ConfigError::Parse {
+        path: path.to_path_buf(),
+        message: e.to_string().trim_end().to_string(),
+    })?;
+    Ok(k.pipeline.name.unwrap_or_default())
 }
 
 /// Parse the whole file with the experiment's parameter type.
@@ -280,6 +294,13 @@ fn dataset_name(file: &std::path::Path) -> String {
     let Some(folder) = file.parent() else {
         return String::new();
     };
+    if crate::storage::is_url(file) {
+        // no scenario file to look for in a store: a `full/` folder is a profile's
+        return match folder.parent() {
+            Some(up) if name(folder) == "full" => name(up),
+            _ => name(folder),
+        };
+    }
     match folder.parent() {
         Some(up)
             if !folder.join("scenario.toml").is_file() && up.join("scenario.toml").is_file() =>
@@ -290,7 +311,28 @@ fn dataset_name(file: &std::path::Path) -> String {
     }
 }
 
-/// Expand globs (sorted, without repeats), drop excluded names, name each session. A folder
+/// The session of log `p`, unless an exclude pattern drops it.
+fn session_of(p: PathBuf, excludes: &[glob::Pattern]) -> Option<SessionRef> {
+    let file = p
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if excludes
+        .iter()
+        .any(|e| e.matches(&file) || e.matches_path(&p))
+    {
+        return None;
+    }
+    let dataset = dataset_name(&p);
+    let name = file.strip_suffix(".mcap").unwrap_or(&file).to_string();
+    Some(SessionRef {
+        dataset,
+        name,
+        path: p,
+    })
+}
+
+/// Expand globs (sorted, without repeats; `s3://` globs list the store, feature `s3`), drop excluded names, name each session. A folder
 /// on a glob's way that cannot be read is an error naming it (its sessions would be missing).
 pub fn find_sessions(
     patterns: &[String],
@@ -307,6 +349,18 @@ pub fn find_sessions(
         .collect::<Result<_, _>>()?;
     let mut out = Vec::new();
     for pattern in patterns {
+        if crate::storage::is_url(Path::new(pattern)) {
+            let urls = crate::storage::list_matching(pattern).map_err(|e| ConfigError::Glob {
+                pattern: pattern.clone(),
+                reason: e.to_string(),
+            })?;
+            out.extend(
+                urls.into_iter()
+                    .map(PathBuf::from)
+                    .filter_map(|p| session_of(p, &excludes)),
+            );
+            continue;
+        }
         let paths = glob::glob(pattern).map_err(|e| ConfigError::Glob {
             pattern: pattern.clone(),
             reason: e.to_string(),
@@ -320,23 +374,7 @@ pub fn find_sessions(
             if !p.is_file() {
                 continue;
             }
-            let file = p
-                .file_name()
-                .map(|f| f.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            if excludes
-                .iter()
-                .any(|e| e.matches(&file) || e.matches_path(&p))
-            {
-                continue;
-            }
-            let dataset = dataset_name(&p);
-            let name = file.strip_suffix(".mcap").unwrap_or(&file).to_string();
-            out.push(SessionRef {
-                dataset,
-                name,
-                path: p,
-            });
+            out.extend(session_of(p, &excludes));
         }
     }
     out.sort();

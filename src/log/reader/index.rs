@@ -8,8 +8,8 @@
 //! [`LinearIndex`]); [`read_summary_section`] and [`linear_index`] only feed them from the
 //! file.
 
+use super::source::Source;
 use std::collections::{BTreeMap, BTreeSet};
-use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::sync::Arc;
 
@@ -170,7 +170,7 @@ pub(super) fn summary_from_section(
 /// Read the summary section through the footer. `None` if the file has no (valid) footer or
 /// no summary section.
 pub(super) fn read_summary_section(
-    file: &mut File,
+    file: &mut Source,
     file_len: u64,
 ) -> Result<Option<LogSummary>, LogErrorKind> {
     if file_len < 8 + FOOTER_RECORD_LEN + 8 {
@@ -389,7 +389,7 @@ impl LinearIndex {
 }
 
 /// Build the index by reading the file front to back (no usable summary section).
-pub(super) fn linear_index(file: &mut File, file_len: u64) -> Result<LogSummary, LogErrorKind> {
+pub(super) fn linear_index(file: &mut Source, file_len: u64) -> Result<LogSummary, LogErrorKind> {
     linear_pass(file, file_len, false)
 }
 
@@ -397,11 +397,18 @@ pub(super) fn linear_index(file: &mut File, file_len: u64) -> Result<LogSummary,
 /// record inside) is skipped, and a cut or corrupt record framing ends the index there; each
 /// loss is said in [`LogSummary::warnings`] (bytes, time span where known, last good message).
 /// The stream then reads only what was indexed.
-pub(super) fn recovering_index(file: &mut File, file_len: u64) -> Result<LogSummary, LogErrorKind> {
+pub(super) fn recovering_index(
+    file: &mut Source,
+    file_len: u64,
+) -> Result<LogSummary, LogErrorKind> {
     linear_pass(file, file_len, true)
 }
 
-fn linear_pass(file: &mut File, file_len: u64, recover: bool) -> Result<LogSummary, LogErrorKind> {
+fn linear_pass(
+    file: &mut Source,
+    file_len: u64,
+    recover: bool,
+) -> Result<LogSummary, LogErrorKind> {
     let mut index = LinearIndex::new(file_len);
     let mut reader = BufReader::with_capacity(1 << 16, &mut *file);
     reader.seek(SeekFrom::Start(8))?;

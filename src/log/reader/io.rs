@@ -1,14 +1,14 @@
 //! Bounded reads from a log file: a read never reaches past the file's end, so a corrupt
 //! offset or length gives a [`LogErrorKind::Truncated`] error, never a huge allocation.
 
-use std::fs::File;
+use super::source::Source;
 use std::io::{Read, Seek, SeekFrom};
 
 use super::super::error::LogErrorKind;
 
 /// Read `len` bytes at `offset`, or say that the file ends first (`what` names the record).
 pub(super) fn read_at(
-    file: &mut File,
+    file: &mut Source,
     offset: u64,
     len: u64,
     file_len: u64,

@@ -9,9 +9,9 @@
 //! [`Catalog`] turns chunk bytes into messages; neither does I/O. [`MessageStream`] feeds them
 //! from the file.
 
+use super::source::Source;
 use std::cmp::Reverse;
 use std::collections::{BTreeMap, BTreeSet, BinaryHeap};
-use std::fs::File;
 use std::io::{BufReader, Read};
 use std::ops::Deref;
 use std::path::PathBuf;
@@ -266,7 +266,7 @@ impl ChunkMerge {
 
 /// Chunks read at their offsets from the chunk index.
 struct Indexed {
-    file: File,
+    file: Source,
     merge: ChunkMerge,
     /// Log time of the latest message handed out.
     yielded: Option<u64>,
@@ -274,7 +274,7 @@ struct Indexed {
 
 /// Records read front to back (messages outside chunks).
 struct Linear {
-    reader: BufReader<File>,
+    reader: BufReader<Source>,
     pos: u64,
     current: Option<Slot>,
 }
@@ -304,7 +304,7 @@ impl MessageStream {
         path: PathBuf,
         summary: &LogSummary,
         topics: Option<BTreeSet<String>>,
-        file: File,
+        file: Source,
     ) -> MessageStream {
         let s = summary;
         let mode = if s.unchunked_messages {
