@@ -193,17 +193,39 @@ fn remote_products(out: &str, pipeline: &str) -> BTreeMap<String, Vec<u8>> {
     m
 }
 
-/// Bytes fetched by opening `url` and by reading its `topic`; the messages read.
-fn fetched_for(url: &str, topic: &str) -> (u64, u64, usize) {
+/// What reading `topic` of the log at `url` fetched.
+struct Fetched {
+    /// Bytes fetched by opening the log (footer, summary section, header).
+    opened: u64,
+    /// Bytes fetched by streaming the topic.
+    read: u64,
+    messages: usize,
+    /// All chunk bytes, and those of the chunks whose index lists the topic's channel.
+    chunk_bytes: u64,
+    wanted_chunk_bytes: u64,
+}
+
+fn fetched_for(url: &str, topic: &str) -> Fetched {
     let before = storage::bytes_fetched();
     let log = SessionLog::open(url).expect("open");
     let opened = storage::bytes_fetched() - before;
-    let n = log
+    let messages = log
         .messages_on(&[topic])
         .expect("topic")
         .map(|m| m.expect("message"))
         .count();
-    (opened, storage::bytes_fetched() - before - opened, n)
+    let s = log.summary();
+    let id = s.channel(topic).expect("channel").id;
+    let wanted = |c: &&peopletrack::log::reader::ChunkInfo| {
+        c.channels.as_ref().is_none_or(|chs| chs.contains(&id))
+    };
+    Fetched {
+        opened,
+        read: storage::bytes_fetched() - before - opened,
+        messages,
+        chunk_bytes: s.chunks.iter().map(|c| c.length).sum(),
+        wanted_chunk_bytes: s.chunks.iter().filter(wanted).map(|c| c.length).sum(),
+    }
 }
 
 /// A log whose first half has only `/front` and second half only `/rear` scans, in 16 KiB
@@ -324,29 +346,37 @@ fn a_pipeline_runs_on_logs_and_a_cache_in_object_storage() {
         let bytes = std::fs::read(&path).expect("log");
         let size = bytes.len() as u64;
         storage::put(&url, bytes).expect("put");
-        let (opened, read, n) = fetched_for(&url, topic);
+        let f = fetched_for(&url, topic);
         let local_n = SessionLog::open(&path)
             .expect("open local")
             .messages_on(&[topic])
             .expect("topic")
             .count();
         assert_eq!(
-            n, local_n,
+            f.messages, local_n,
             "{what}: the store gave other messages than the file"
         );
+        // opening reads no chunk; the stream reads exactly the chunks that hold the topic
         assert!(
-            opened < size / 10,
-            "{what}: opening fetched {opened} of {size} bytes"
+            f.opened <= size - f.chunk_bytes,
+            "{what}: opening fetched {} bytes, more than all but the chunks ({})",
+            f.opened,
+            size - f.chunk_bytes
         );
+        assert_eq!(f.read, f.wanted_chunk_bytes, "{what}: bytes streamed");
         eprintln!(
-            "FETCHED {what}: open {opened} B, one-topic read {read} B ({n} messages), file {size} B: {:.1} % of the file",
-            100.0 * (opened + read) as f64 / size as f64
+            "FETCHED {what}: open {} B + one-topic read {} B ({} messages) of a {size} B file: {:.1} %",
+            f.opened,
+            f.read,
+            f.messages,
+            100.0 * (f.opened + f.read) as f64 / size as f64
         );
         if what.starts_with("two-phase") {
             assert!(
-                (opened + read) * 10 < size * 6,
-                "{what}: fetched {} of {size} bytes: chunks without the topic were read",
-                opened + read
+                f.wanted_chunk_bytes * 10 < f.chunk_bytes * 6,
+                "{what}: the topic's chunks are {} of {} chunk bytes: the log is not split by topic",
+                f.wanted_chunk_bytes,
+                f.chunk_bytes
             );
         }
     }
