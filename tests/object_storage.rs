@@ -212,8 +212,9 @@ fn fetched_for(url: &str, topic: &str) -> Fetched {
     let messages = log
         .messages_on(&[topic])
         .expect("topic")
-        .map(|m| m.expect("message"))
-        .count();
+        .collect::<Result<Vec<_>, _>>()
+        .expect("messages")
+        .len();
     let s = log.summary();
     let id = s.channel(topic).expect("channel").id;
     let wanted = |c: &&peopletrack::log::reader::ChunkInfo| {
