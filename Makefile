@@ -7,7 +7,7 @@ VENV_MOT := target/py-venv-mot
 # the notebook guide's readers (docs/notebooks.md)
 VENV_NB := target/py-venv-notebook
 
-.PHONY: help eval datasets release build-s3 test test-s3 bench interop notebook-check audio-interop clean opencv-agreement stonesoup-agreement bench-gmm bench-multicam bench-laser wildtrack
+.PHONY: help eval datasets release build-s3 test test-s3 bench interop notebook-check schemas audio-interop clean opencv-agreement stonesoup-agreement bench-gmm bench-multicam bench-laser wildtrack
 
 PROFILE ?= quick
 
@@ -21,6 +21,7 @@ help:
 	@echo "make bench     criterion benchmarks + the same reads in Python mcap-ros2-support, with ratios"
 	@echo "make bench-mot tracking metrics: criterion on a synthetic sequence + py-motmetrics on the same files, with the ratio"
 	@echo "make interop   check that Python mcap-ros2-support opens what we write, synthetic datasets included (throwaway venv)"
+	@echo "make schemas   regenerate docs/schemas.md (every table's columns and types) from out/ of a finished make eval"
 	@echo "make notebook-check  run docs/notebooks.md's Python (polars, pandas, DuckDB) against a fresh dataset_quality run (throwaway venv)"
 	@echo "make audio-interop  read the BIRON audio back with Python mcap-ros2-support: a fixture and a biron_home session, samples equal (throwaway venv)"
 	@echo "make opencv-agreement  pixel agreement of vision::gmm masks with OpenCV MOG2, fails below 100 % (throwaway venv)"
@@ -80,6 +81,13 @@ interop: $(VENV)/ok
 	$(VENV)/bin/python tools/check_mcap_ros2.py target/interop/fixture.mcap target/interop/expected.json
 	$(MAKE) datasets
 	$(VENV)/bin/python tools/check_synth_ros2.py ./target/release/peopletrack datasets/*/*.mcap
+
+# Issue 34: docs/schemas.md, the schema of every table the pipelines write, generated from what a
+# `make eval` left in out/ (Parquet footers) and the meanings in code; `make test` checks the
+# pipelines its tests run against it. The real WILDTRACK pipeline joins when `make wildtrack` ran.
+SCHEMA_PIPELINES := $(sort $(wildcard pipelines/*.toml)) $(if $(wildcard out/s004_wildtrack/tables),pipelines/real/s004_wildtrack.toml,)
+schemas: release
+	./target/release/peopletrack schemas $(SCHEMA_PIPELINES) --out out -o docs/schemas.md
 
 # Issue 34: the notebook guide's code, block by block, against a fresh run of dataset_quality
 # (hive-style per-session cache: out/<pipeline>/sessions/dataset=<d>/session=<s>/).

@@ -266,6 +266,7 @@ fn two_walkers_are_tracked_exactly() {
     let sessions = vec![format!("{}/*.mcap", data.display())];
     let summary = run_file(&toml, &options(&out, sessions)).expect("runs");
     assert!(summary.skipped.is_empty(), "{:?}", summary.skipped);
+    crate::common::assert_schemas_documented(&toml, &out);
 
     let rows = csv_rows(&out.join("laser_people/tables/results.csv"));
     let legs = row(&rows, "walkers_00", "legs");

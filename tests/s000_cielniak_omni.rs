@@ -92,6 +92,7 @@ fn calibrates_learns_tracks_and_the_saved_model_reproduces_its_estimates() {
             out
         })
         .collect();
+    crate::common::assert_schemas_documented(&train, &outs[0]);
     let tables = |out: &Path| outs_dir(out).join("tables");
     for name in [
         "calibration",

@@ -103,6 +103,10 @@ fn the_closed_loop_is_reproduced_by_its_replay_and_the_robot_keeps_the_person() 
     let out = f.root.join("out_j2");
     let o = run(f, &out, "2");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    common::assert_schemas_documented(
+        &root().join("pipelines/s001_kobilarov_following.toml"),
+        &out,
+    );
     let t = out.join("s001_kobilarov_following/tables");
     // the replayed paper configuration is the robot's own tracker on the same scans: the
     // estimates agree to well under the laser's noise-free blob spread

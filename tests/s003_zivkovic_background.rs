@@ -159,6 +159,7 @@ fn pipeline_end_to_end_on_a_tiny_scene() {
     let (o1, o2) = (dir.path().join("o1"), dir.path().join("o2"));
     run(&toml, &sessions, &o1, "1");
     run(&toml, &sessions, &o2, "2");
+    crate::common::assert_schemas_documented(&toml, &o1);
     let (a, b) = (
         files(&o1.join("s003_zivkovic_background")),
         files(&o2.join("s003_zivkovic_background")),

@@ -214,6 +214,7 @@ fn ground_truth_boxes_through_the_log_detector_path_reach_mota_095_and_tracks_re
         &["--write-tracks".as_ref(), tracks.as_os_str()],
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    common::assert_schemas_documented(&f.pipeline, &out);
 
     let rows = csv(&out.join("s004_mohedano_multicam/tables/clear_mot.csv"));
     let mut seen = 0;

@@ -91,6 +91,7 @@ fn shards_give_the_tables_of_one_run() {
     let sessions = five_sessions(&data);
     let single = dir.path().join("single");
     check(&run(&single, &sessions, &["-j", "2"]), "unsharded run");
+    common::assert_schemas_documented(&pipeline(), &single);
     let want = common::products(&single, "dataset_quality");
     let skipped = String::from_utf8(want["tables/skipped_sessions.csv"].clone()).expect("utf8");
     assert!(

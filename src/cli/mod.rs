@@ -8,6 +8,7 @@ pub mod import;
 pub mod inspect;
 pub mod progress;
 pub mod run;
+pub mod schemas;
 pub mod score;
 pub mod submit;
 pub mod synth;
@@ -72,6 +73,10 @@ pub enum Command {
     /// Run one pipeline on a Slurm cluster: an array of shards, then the aggregate, e.g.
     /// `peopletrack submit --slurm pipelines/laser_people.toml --shards 16`.
     Submit(submit::Args),
+    /// Print the schema of every table the pipelines wrote (per-session cache and aggregate
+    /// tables, from the Parquet footers) as Markdown, or check them against a page, e.g.
+    /// `peopletrack schemas pipelines/*.toml --check docs/schemas.md`.
+    Schemas(schemas::Args),
     /// Write a session's two-microphone audio as a WAV file to listen to, e.g.
     /// `peopletrack wav datasets/biron_home/biron_home_00.mcap -o biron.wav`.
     Wav(wav::Args),
@@ -107,6 +112,7 @@ pub fn main() -> ExitCode {
         Command::Train(a) => train::run(a, &mut out),
         Command::Import(a) => import::run(a, &mut out),
         Command::Submit(a) => submit::run(a, &mut out),
+        Command::Schemas(a) => schemas::run(a, &mut out),
         Command::Wav(a) => wav::run(a, &mut out),
     }
     .and_then(|()| out.flush().map_err(anyhow::Error::from));

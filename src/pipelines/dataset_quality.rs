@@ -19,9 +19,32 @@ use crate::report::{Figure, Table};
 
 use crate::report::columns::{concat as stack, f64s as col_f64, strs as col_str};
 use crate::run::config::Invalid;
+use crate::run::schemas::{TableDoc, table};
 use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
 
 pub struct DatasetQuality;
+
+/// Every per-session table and what a row of it is (`docs/schemas.md`).
+const SESSION_TABLES: &[TableDoc] = &[
+    table(
+        "session",
+        "The log as a whole (one row): duration, messages, topics, bytes, the writing library, \
+         TF edges and invalid transforms, ground-truth frames, people, speeds and visibility.",
+    ),
+    table(
+        "topics",
+        "One topic: schema, encodings, count, rate, median period, gaps, header-stamp offsets \
+         (null without header stamps), decode failures and the decoder used.",
+    ),
+    table(
+        "rates",
+        "One topic in one time bin: the message rate over the bin (Hz).",
+    ),
+    table(
+        "tf",
+        "One TF edge: parent, child, whether static, and how many samples it has.",
+    ),
+];
 
 /// `[params]` of `pipelines/dataset_quality.toml`.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -52,6 +75,7 @@ fn topic(topics: &BTreeMap<String, String>, logical: &str, default: &str) -> Str
 impl Experiment for DatasetQuality {
     const KIND: &'static str = "dataset_quality";
     const VERSION: u32 = 1;
+    const SESSION_TABLES: &'static [TableDoc] = SESSION_TABLES;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

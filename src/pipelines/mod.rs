@@ -12,6 +12,7 @@ pub mod s004_mohedano_multicam;
 
 use std::path::Path;
 
+use crate::run::schemas::KindInfo;
 use crate::run::{
     Experiment, RunOptions, RunSummary, check_experiment, config, run_experiment, unknown_kind,
 };
@@ -32,6 +33,19 @@ macro_rules! registry {
                 }
             )*
             Err(unknown_kind(path, &kind, KINDS).into())
+        }
+
+        /// What the registry knows of a kind: its `VERSION` and its per-session tables.
+        pub fn kind_info(kind: &str) -> Option<KindInfo> {
+            $(
+                if kind == <$ty as Experiment>::KIND {
+                    return Some(KindInfo {
+                        version: <$ty as Experiment>::VERSION,
+                        session_tables: <$ty as Experiment>::SESSION_TABLES,
+                    });
+                }
+            )*
+            None
         }
 
         /// Parse and validate a pipeline file's text as its `kind` (no sessions are looked

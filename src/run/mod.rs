@@ -31,6 +31,7 @@ pub mod config;
 mod inputs;
 pub mod lock;
 pub mod report;
+pub mod schemas;
 pub mod shard;
 pub mod skipped;
 pub mod slurm;
@@ -98,6 +99,9 @@ pub trait Experiment: Sync {
     /// Bump when per-session results change meaning: cached results of older versions are
     /// recomputed.
     const VERSION: u32;
+    /// The per-session tables `process` writes and what a row of each is: `docs/schemas.md`
+    /// is generated from it (`peopletrack schemas`, which refuses a table missing here).
+    const SESSION_TABLES: &'static [schemas::TableDoc] = &[];
     type Params: DeserializeOwned + Serialize + Default + Sync + std::fmt::Debug;
 
     /// Parameter checks beyond types: `(key, reason)` for each problem.

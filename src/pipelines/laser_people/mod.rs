@@ -31,6 +31,7 @@ use std::path::PathBuf;
 
 use crate::progress::Progress;
 use crate::run::config::Invalid;
+use crate::run::schemas::{TableDoc, table};
 use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
 
 pub use learned::LearnedParams;
@@ -38,9 +39,40 @@ pub use params::{Params, Sequence};
 
 pub struct LaserPeople;
 
+/// Every per-session table and what a row of it is (`docs/schemas.md`).
+const SESSION_TABLES: &[TableDoc] = &[
+    table(
+        tables::SESSION,
+        "What one session read (one row): topics, ground-truth kind, fixed frame, scans, \
+         odometry source and its error, ground-truth rows kept and dropped, skipped messages.",
+    ),
+    table(
+        tables::SCANS,
+        "One scan: index, stamps, whether TF placed it, legs and people the leg model found.",
+    ),
+    table(
+        tables::TRUTH,
+        "A ground-truth person on a scan, laser frame (m).",
+    ),
+    table(
+        tables::TRACKS,
+        "A hypothesis of one detector on a scan: `x`, `y` in the laser frame, `world_x`, \
+         `world_y` in the fixed frame (m).",
+    ),
+    table(
+        view::POSES,
+        "The laser on one scan: its frame id and its pose (`x`, `y` m, `yaw` rad) in the fixed frame.",
+    ),
+    table(
+        view::POINTS,
+        "One return of a sampled scan in the fixed frame (m, rounded to 1 cm), for the top views.",
+    ),
+];
+
 impl Experiment for LaserPeople {
     const KIND: &'static str = "laser_people";
     const VERSION: u32 = 6;
+    const SESSION_TABLES: &'static [TableDoc] = SESSION_TABLES;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

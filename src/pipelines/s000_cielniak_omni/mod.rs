@@ -63,6 +63,7 @@ impl Experiment for OmniAppearance {
     /// 2: the session stage reads through the frames layer (bad messages skipped and counted
     /// in a `skips` table instead of failing the session).
     const VERSION: u32 = 2;
+    const SESSION_TABLES: &'static [crate::run::schemas::TableDoc] = tables::SESSION_TABLES;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

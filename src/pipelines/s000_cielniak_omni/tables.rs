@@ -4,8 +4,30 @@
 use polars::prelude::DataFrame;
 
 use crate::report::rows::Rows;
+use crate::run::schemas::{TableDoc, table};
 use crate::run::{Aggregate, SessionTables};
 use crate::table_row;
+
+/// Every per-session table and what a row of it is (`docs/schemas.md`).
+pub const SESSION_TABLES: &[TableDoc] = &[
+    table(
+        "cameras",
+        "A webcam's nominal parameters (TF pose, camera_info).",
+    ),
+    table("camera_truth", "A webcam's true pose (simulator metadata)."),
+    table("hats", "A hat blob in a webcam frame."),
+    table("targets", "A calibration mark where the hat stands."),
+    table("truth", "A person's true position (simulator)."),
+    table(
+        "omni",
+        "The depth-cue features of one omni frame (NaN where no person).",
+    ),
+    table("omni_pose", "The omni camera's pose in the map (one row)."),
+    table(
+        "skips",
+        "Messages the frames layer skipped on one topic (they did not decode).",
+    ),
+];
 
 table_row! {
     /// A webcam's nominal parameters (TF pose, camera_info): `cameras`.

@@ -42,6 +42,7 @@ pub struct KobilarovFollowing;
 impl Experiment for KobilarovFollowing {
     const KIND: &'static str = "s001_kobilarov_following";
     const VERSION: u32 = 3;
+    const SESSION_TABLES: &'static [crate::run::schemas::TableDoc] = tables::SESSION_TABLES;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

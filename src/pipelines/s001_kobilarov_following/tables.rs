@@ -4,6 +4,7 @@
 use anyhow::Context;
 
 use crate::report::rows::Rows;
+use crate::run::schemas::{TableDoc, table};
 use crate::run::{Aggregate, SessionTables};
 use crate::table_row;
 
@@ -13,6 +14,39 @@ pub const LOOP: &str = "closed_loop";
 pub const METHOD1: &str = "method1";
 pub const REAL: &str = "real";
 pub const COLOUR: &str = "colour";
+
+/// Every per-session table and what a row of it is (`docs/schemas.md`).
+pub const SESSION_TABLES: &[TableDoc] = &[
+    table(
+        TRACKS,
+        "One replayed method on one scan: its estimate in the evaluation frame (`map` on \
+         synthetic logs, the laser frame on real ones) and what it did.",
+    ),
+    table(
+        TRUTH,
+        "The ground truth at each scan (synthetic logs, `map` frame): the robot's true pose and \
+         speed, the target, and whether the laser could see the target.",
+    ),
+    table(
+        LOOP,
+        "The closed loop's own tracker output on one scan, as the robot logged it \
+         (`/follower/state`), moved into `map`.",
+    ),
+    table(
+        METHOD1,
+        "Method 1 on one omni frame: the detection's bearing, the target's true bearing in the \
+         camera frame and the robot's speed.",
+    ),
+    table(
+        REAL,
+        "A real laser log: one method on one annotated scan (laser frame); empty for synthetic logs.",
+    ),
+    table(
+        COLOUR,
+        "One blob of one scan as the paper's configuration saw it: its normalised correlation \
+         with the template, what the ground truth says it is, and a person's blob's offset (m).",
+    ),
+];
 
 table_row! {
     /// One replayed method on one scan: its estimate in the evaluation frame (`map` on

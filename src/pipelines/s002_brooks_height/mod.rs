@@ -46,6 +46,7 @@ pub struct BrooksHeight;
 impl Experiment for BrooksHeight {
     const KIND: &'static str = "s002_brooks_height";
     const VERSION: u32 = 2;
+    const SESSION_TABLES: &'static [crate::run::schemas::TableDoc] = tables::SESSION_TABLES;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

@@ -5,6 +5,7 @@ use anyhow::Context;
 
 use crate::report::rows::Rows;
 use crate::run::SessionTables;
+use crate::run::schemas::{TableDoc, table};
 use crate::table_row;
 
 pub const LASER: &str = "laser_obs";
@@ -12,6 +13,38 @@ pub const CAMERA: &str = "camera_obs";
 pub const TRUTH: &str = "truth";
 pub const PLANES: &str = "planes";
 pub const FIG4: &str = "fig4";
+
+/// Every per-session table and what a row of it is (`docs/schemas.md`), single and multi mode.
+pub const SESSION_TABLES: &[TableDoc] = &[
+    table(
+        LASER,
+        "A leg pair on a scan (§3): range–bearing of the midpoint in the laser frame, and the \
+         laser's pose on the floor plan (map frame).",
+    ),
+    table(
+        CAMERA,
+        "A camera person detection (§4): bearing and elevation of the head top in the map frame \
+         from the camera centre, the pixel, the blob rectangle and its top-fifth skin share.",
+    ),
+    table(
+        "camera_obs_{name}",
+        "Multi mode: camera `{name}`'s person detections, the columns of `camera_obs`.",
+    ),
+    table(TRUTH, "The person's ground truth at one stamp (map frame)."),
+    table(
+        PEOPLE_TRUTH,
+        "Multi mode: one person at one ground-truth stamp (map frame).",
+    ),
+    table(
+        PLANES,
+        "One background-subtraction configuration over the session's frames after warm-up: time \
+         per frame (this machine, one thread) and detection quality against the exact person mask.",
+    ),
+    table(
+        FIG4,
+        "Fig. 4's four panels of one frame as a PNG (base64), at most one row.",
+    ),
+];
 
 table_row! {
     /// A leg pair on a scan (§3): range–bearing of the midpoint in the laser frame, and the

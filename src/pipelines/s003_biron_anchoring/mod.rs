@@ -52,6 +52,7 @@ fn topics(t: &BTreeMap<String, String>) -> session::Topics {
 impl Experiment for BironAnchoring {
     const KIND: &'static str = "s003_biron_anchoring";
     const VERSION: u32 = 1;
+    const SESSION_TABLES: &'static [crate::run::schemas::TableDoc] = tables::SESSION_TABLES;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

@@ -5,6 +5,7 @@ use anyhow::Context;
 
 use crate::report::rows::Rows;
 use crate::run::SessionTables;
+use crate::run::schemas::{TableDoc, table};
 use crate::table_row;
 
 pub const DOA: &str = "doa_blocks";
@@ -17,6 +18,41 @@ pub const TIMELINE: &str = "timeline";
 pub const REPLAY: &str = "replay";
 pub const CORRELOGRAM: &str = "correlogram";
 pub const SKIPS: &str = "skips";
+
+/// Every per-session table and what a row of it is (`docs/schemas.md`).
+pub const SESSION_TABLES: &[TableDoc] = &[
+    table(
+        DOA,
+        "One 0.5 s block of one acoustic condition with a single speaker.",
+    ),
+    table(
+        FACES,
+        "A true face in a frame (in the image, mostly visible).",
+    ),
+    table(
+        FACE_FRAMES,
+        "Detections of a frame and those matching no true face.",
+    ),
+    table(
+        STEPS,
+        "One system variant at one step: its attention and the truth's.",
+    ),
+    table(
+        SPEAKER,
+        "One active sound block of a variant: where it landed and who spoke.",
+    ),
+    table(
+        MOT,
+        "CLEAR MOT of a variant's person anchors over the session.",
+    ),
+    table(TIMELINE, "One anchor of the full system at one step."),
+    table(REPLAY, "The replay against the logged `/attention/state`."),
+    table(
+        CORRELOGRAM,
+        "The direction-of-arrival correlogram figure as a PNG (one row, `png` bytes).",
+    ),
+    table(SKIPS, "Messages skipped while reading, per topic."),
+];
 
 table_row! {
     /// One 0.5 s block of one acoustic condition with a single speaker: `doa_blocks`.

@@ -18,9 +18,9 @@ use crate::run::{Aggregate, Products, SessionTables};
 use crate::table_row;
 use crate::vision::AdaptiveGmm;
 
-const SAMPLES_TABLE: &str = "components";
-const IMAGE_TABLE: &str = "components_image";
-const LAST_FRAME_TABLE: &str = "last_frame";
+pub(super) const SAMPLES_TABLE: &str = "components";
+pub(super) const IMAGE_TABLE: &str = "components_image";
+pub(super) const LAST_FRAME_TABLE: &str = "last_frame";
 
 table_row! {
     /// Cached per session, one row per frame: mean components per pixel of both models.

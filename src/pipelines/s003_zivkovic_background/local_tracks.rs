@@ -15,9 +15,9 @@ use crate::run::{Aggregate, Products, SessionTables};
 use crate::table_row;
 use crate::vision::local::{HandOver, LocalTracker, Mode};
 
-const TRACKS_TABLE: &str = "tracks";
-const GT_TABLE: &str = "gt_boxes";
-const HAS_GT_TABLE: &str = "has_ground_truth";
+pub(super) const TRACKS_TABLE: &str = "tracks";
+pub(super) const GT_TABLE: &str = "gt_boxes";
+pub(super) const HAS_GT_TABLE: &str = "has_ground_truth";
 
 table_row! {
     /// Cached per session: one track's observation in one frame.

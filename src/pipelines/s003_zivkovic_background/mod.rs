@@ -76,7 +76,83 @@ pub use params::{
 
 use crate::progress::Progress;
 use crate::run::config::Invalid;
+use crate::run::schemas::{TableDoc, table};
 use crate::run::{Aggregate, Experiment, Products, Session, SessionTables, Stage};
+
+/// Every per-session table and what a row of it is (`docs/schemas.md`).
+const SESSION_TABLES: &[TableDoc] = &[
+    table(
+        shared::SESSION_TABLE,
+        "What was read, and each stage's counters (one row).",
+    ),
+    table(
+        local_tracks::TRACKS_TABLE,
+        "One local track's observation in one frame.",
+    ),
+    table(
+        local_tracks::GT_TABLE,
+        "A ground-truth person's box in one frame (right and bottom exclusive); people less \
+         visible than `local_eval.min_visibility` left out.",
+    ),
+    table(
+        local_tracks::HAS_GT_TABLE,
+        "Whether the log has ground truth (one row, `value`).",
+    ),
+    table(
+        moving::TABLE,
+        "The session's moving-camera detection counts (one row).",
+    ),
+    table(
+        reid::FRAMES_TABLE,
+        "The region means of one box's pixel set in one frame (re-identification).",
+    ),
+    table(
+        snapshots::BOXES_TABLE,
+        "One box of a kept re-identification snapshot frame.",
+    ),
+    table(
+        "reid_snapshot_{n}",
+        "The `{n}`-th kept re-identification snapshot: the image as PNG bytes and its frame (one row).",
+    ),
+    table(
+        components::SAMPLES_TABLE,
+        "One frame: mean components per pixel of both models.",
+    ),
+    table(
+        components::IMAGE_TABLE,
+        "The adaptive model's components at the last frame, one row per pixel in row-major order.",
+    ),
+    table(
+        components::LAST_FRAME_TABLE,
+        "The last frame as PNG bytes (one row).",
+    ),
+    table(
+        roc::COUNTS_TABLE,
+        "One model at one c_thr: mask counts summed over the scored frames.",
+    ),
+    table(
+        roc::PEOPLE_TABLE,
+        "Person pixels (exact mask inside a person's box) of standing or walking people, and how \
+         the adaptive model at c_thr = 16 labelled them.",
+    ),
+    table(
+        roc::COMPONENTS_TABLE,
+        "A variant's mean components per pixel summed over the frames with masks.",
+    ),
+    table(
+        timing::SAMPLES_TABLE,
+        "One frame: the fastest of repeated updates of each timed model (ms).",
+    ),
+    table(
+        colour::SAMPLES_TABLE,
+        "One colour tracker's estimate in one frame, with the ground-truth ellipse where the \
+         person is fully in view.",
+    ),
+    table(
+        "colour_overlay_{n}",
+        "The `{n}`-th overlay frame of the colour trackers as PNG bytes and its frame (one row).",
+    ),
+];
 
 pub struct BackgroundTracking;
 
@@ -89,6 +165,7 @@ impl Experiment for BackgroundTracking {
     // 6: `reid_frames` per box and pixel set (tracker foreground, exact id mask, box), raw
     //    region means and frame means; `reid.train_datasets` too
     const VERSION: u32 = 6;
+    const SESSION_TABLES: &'static [TableDoc] = SESSION_TABLES;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

@@ -20,7 +20,7 @@ use crate::run::{Aggregate, Products, SessionTables};
 use crate::table_row;
 use crate::vision::moving::{MovingDetector, MovingFrame};
 
-const TABLE: &str = "moving_detection";
+pub(super) const TABLE: &str = "moving_detection";
 
 table_row! {
     /// One session's moving-camera detection counts.

@@ -22,7 +22,7 @@ use crate::vision::AdaptiveGmm;
 
 /// Runs of each frame's update; the fastest is kept.
 const REPEATS: usize = 3;
-const SAMPLES_TABLE: &str = "timing";
+pub(super) const SAMPLES_TABLE: &str = "timing";
 
 table_row! {
     /// Cached per session, one row per frame: the fastest of [`REPEATS`] updates (ms).

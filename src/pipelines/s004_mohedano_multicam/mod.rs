@@ -84,6 +84,7 @@ pub(crate) fn topics(p: &Params, remap: &BTreeMap<String, String>) -> Topics {
 impl Experiment for MulticamCylinders {
     const KIND: &'static str = "s004_mohedano_multicam";
     const VERSION: u32 = 4;
+    const SESSION_TABLES: &'static [crate::run::schemas::TableDoc] = tables::SESSION_TABLES;
     type Params = Params;
 
     fn validate(p: &Params) -> Vec<Invalid> {

@@ -2,6 +2,7 @@
 //! the aggregation (`scored`, `evaluate`, `figures`, `markers`) reads them back; nothing
 //! else passes between the two.
 
+use crate::run::schemas::{TableDoc, table};
 use crate::table_row;
 
 /// Names of the cached per-session tables.
@@ -26,6 +27,66 @@ pub(crate) const VIEW_FRAME: &str = "view_frame";
 /// the association) and each level's box counts; absent without `detector_noise`.
 pub(crate) const NOISE_TRACKS: &str = "noise_tracks";
 pub(crate) const NOISE_BOXES: &str = "noise_boxes";
+
+/// Every per-session table and what a row of it is (`docs/schemas.md`).
+pub(crate) const SESSION_TABLES: &[TableDoc] = &[
+    table(
+        CALIBRATION,
+        "One camera's position and heading in the world frame.",
+    ),
+    table(
+        TRACKS,
+        "One 3-D track in one frame of one run (detector, selection rule, `N_app`).",
+    ),
+    table(GT, "One ground-truth person at one frame."),
+    table(
+        HEAD_CENTROID,
+        "Ground error of triangulating one person's head points and blob centroids at one frame.",
+    ),
+    table(
+        CAMERAS,
+        "One camera's image stages at one frame (templates detector).",
+    ),
+    table(
+        DETECTIONS_2D,
+        "Template detections of one camera at one frame against the visible ground-truth boxes; \
+         head offsets and height ratios are sums over the matched pairs.",
+    ),
+    table(
+        ERRORS_2D,
+        "One miss or false detection of the template chain at one frame and camera, with its \
+         cause; scores are NaN where they do not apply.",
+    ),
+    table(VARIANTS, "The search statistics of one 3-D run."),
+    table(
+        TIMING_3D,
+        "One frame of the main run's 3-D stage, timed (fastest of 3 steps; measured, varies).",
+    ),
+    table(SESSION, "The session as a whole (one row)."),
+    table(
+        VIEW_IMAGE,
+        "The camera images at the frame the camera-view figure shows, as PNG bytes.",
+    ),
+    table(
+        VIEW_SHAPES,
+        "One vertex of a shape drawn over the camera-view canvas: polyline vertices in order, or \
+         the two corners of a labelled box.",
+    ),
+    table(
+        VIEW_FRAME,
+        "The frame of the camera-view figure (one row), or why there is no view.",
+    ),
+    table(
+        NOISE_TRACKS,
+        "The detector-noise runs' tracks (the columns of `tracks`: `detector` = the noise level, \
+         `selection` = the association); only with `detector_noise`.",
+    ),
+    table(
+        NOISE_BOXES,
+        "The boxes of one noise level in one session, before and after the detector model; only \
+         with `detector_noise`.",
+    ),
+];
 
 table_row! {
     /// The boxes of one noise level in one session: before and after the detector model.
