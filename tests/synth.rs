@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use peopletrack::groundtruth::PeopleFrame;
 use peopletrack::log::msgs::{CompressedImage, Image, LaserScan};
 use peopletrack::log::{Decoders, SessionLog, read_topic};
-use peopletrack::synth::{SynthOptions, SynthSummary, synthesize};
+use peopletrack::synth::{SynthOptions, SynthSummary, synthesize, synthesize_sessions};
 
 fn scenario() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny_scenario.toml")
@@ -358,5 +358,32 @@ fn the_id_mask_names_each_persons_pixels_and_a_profile_can_start_at_any_session(
     assert_ne!(
         std::fs::read(&quick.sessions[0]).expect("00"),
         std::fs::read(&summary.sessions[0]).expect("07")
+    );
+}
+
+/// `synth --missing-only` finishes an interrupted render: only the absent session is written,
+/// and it is byte for byte the one a whole render writes.
+#[test]
+fn an_interrupted_render_is_finished_with_the_same_bytes() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let whole = synth_into(&dir.path().join("whole"), 1);
+    assert!(whole.len() >= 2, "the fixture has several sessions");
+    let part = dir.path().join("part");
+    std::fs::create_dir_all(&part).expect("mkdir");
+    // the render was cut after every session but the last
+    for p in &whole[..whole.len() - 1] {
+        std::fs::copy(p, part.join(p.file_name().expect("name"))).expect("copy");
+    }
+    let opts = SynthOptions {
+        profile: "quick".into(),
+        out: Some(part.clone()),
+        progress: None,
+    };
+    let done = synthesize_sessions(&scenario(), &opts, true).expect("synthesizes");
+    let last = whole.last().expect("a session");
+    assert_eq!(done.sessions, [part.join(last.file_name().expect("name"))]);
+    assert!(
+        std::fs::read(last).expect("whole") == std::fs::read(&done.sessions[0]).expect("part"),
+        "the finished session differs from the whole render's"
     );
 }

@@ -23,6 +23,10 @@ pub struct Args {
     /// Skip scenarios whose logs already exist.
     #[arg(long)]
     pub if_absent: bool,
+    /// Render only the sessions whose log is absent (to finish an interrupted render: each
+    /// session depends only on its index and seed, so the logs equal one whole render's).
+    #[arg(long, conflicts_with = "if_absent")]
+    pub missing_only: bool,
 }
 
 pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
@@ -45,13 +49,14 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
             continue;
         }
         let started = std::time::Instant::now();
-        let s = synth::synthesize(
+        let s = synth::synthesize_sessions(
             scenario,
             &SynthOptions {
                 profile: a.profile.clone(),
                 out: a.out.clone(),
                 progress: super::progress::shared(super::stderr_is_terminal()),
             },
+            a.missing_only,
         )?;
         let sheet = match &s.preview {
             Some(data) => Some(preview::write(&a.preview, &s.name, data)?),

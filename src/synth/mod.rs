@@ -70,6 +70,18 @@ pub fn default_out(scenario_path: &Path, profile: &str) -> PathBuf {
 
 /// Synthesize every session of a scenario (sessions in parallel, rows in parallel).
 pub fn synthesize(scenario_path: &Path, opts: &SynthOptions) -> anyhow::Result<SynthSummary> {
+    synthesize_sessions(scenario_path, opts, false)
+}
+
+/// [`synthesize`], leaving out (with `missing_only`) the sessions whose log already exists:
+/// each session is rendered from its own index and seed, so completing an interrupted render
+/// gives the same logs as one uninterrupted render. [`SynthSummary::sessions`] lists the
+/// sessions written.
+pub fn synthesize_sessions(
+    scenario_path: &Path,
+    opts: &SynthOptions,
+    missing_only: bool,
+) -> anyhow::Result<SynthSummary> {
     let (s, text) = Scenario::load(scenario_path, &opts.profile)?;
     let out = opts
         .out
@@ -80,11 +92,14 @@ pub fn synthesize(scenario_path: &Path, opts: &SynthOptions) -> anyhow::Result<S
         .map_or_else(|| PathBuf::from("."), Path::to_path_buf);
     let bars = crate::progress::reporter(&opts.progress);
     let first = s.scenario.first_session;
-    let results: Vec<anyhow::Result<(PathBuf, Option<session::PreviewData>)>> = (first
-        ..first + s.scenario.sessions)
+    let path_of = |k: u32| out.join(format!("{}_{:02}.mcap", s.scenario.name, k));
+    let wanted: Vec<u32> = (first..first + s.scenario.sessions)
+        .filter(|&k| !(missing_only && path_of(k).is_file()))
+        .collect();
+    let results: Vec<anyhow::Result<(PathBuf, Option<session::PreviewData>)>> = wanted
         .into_par_iter()
         .map(|k| {
-            let path = out.join(format!("{}_{:02}.mcap", s.scenario.name, k));
+            let path = path_of(k);
             let bar = bars.bar(&format!("{} {k}", s.scenario.name), "sensor frames");
             // a `[biron]` scenario has its own session writer (seed 003's BIRON, issue 33)
             let preview = match &s.biron {
