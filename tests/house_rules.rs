@@ -38,7 +38,7 @@ const MAX_FN_LINES: usize = 150;
 /// 9. `pipelines` (one experiment each, on `run`);
 /// 10. `cli` (the binary: clap, progress bars; `src/main.rs` and `src/cli/`).
 const LAYERS: &[&[&str]] = &[
-    &["time", "names", "rng", "assign", "progress"],
+    &["time", "names", "rng", "assign", "progress", "storage"],
     &["geometry", "groundtruth"],
     &["log"],
     &["frames"],

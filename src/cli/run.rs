@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use peopletrack::pipelines;
 use peopletrack::report::atomic;
-use peopletrack::run::{RunOptions, config, skipped, slurm};
+use peopletrack::run::{RunOptions, config, lock, skipped, slurm};
 use peopletrack::storage::{self, mirror::Mirror};
 
 #[derive(Debug, clap::Args)]
@@ -140,7 +140,7 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
     let s = pipelines::run_file(&a.pipeline, &opts)?;
     if let (Some(m), false) = (&mirror, a.dry_run) {
         let pushed = m
-            .push()
+            .push(&[lock::LOCK_FILE])
             .with_context(|| format!("writing to {}", a.out.display()))?;
         eprintln!(
             "{}: {} files written ({} bytes), {} unchanged",

@@ -80,9 +80,29 @@ fn open_rw(path: &Path) -> io::Result<File> {
         .map_err(at("opening lock file", path))
 }
 
+/// How long a lock that names this very process as its holder is waited for: an `flock`
+/// this process released stays held while a child process, forked by another thread in that
+/// instant, has not yet reached `exec` (which closes its copy of the descriptor).
+const OWN_LOCK_WAIT: std::time::Duration = std::time::Duration::from_secs(2);
+
 impl FolderLock {
-    /// Lock `folder` (made if absent) for this process, or say who holds it.
+    /// Lock `folder` (made if absent) for this process, or say who holds it. A lock held in
+    /// this process's own name is tried again for up to [`OWN_LOCK_WAIT`] first.
     pub fn acquire(folder: &Path) -> Result<FolderLock, LockError> {
+        let started = std::time::Instant::now();
+        loop {
+            match FolderLock::try_acquire(folder) {
+                Err(LockError::InUse { holder, .. })
+                    if holder == holder_id() && started.elapsed() < OWN_LOCK_WAIT =>
+                {
+                    std::thread::sleep(std::time::Duration::from_millis(10));
+                }
+                result => return result,
+            }
+        }
+    }
+
+    fn try_acquire(folder: &Path) -> Result<FolderLock, LockError> {
         let io = |error: io::Error| LockError::Io {
             folder: folder.to_path_buf(),
             error,

@@ -76,10 +76,11 @@ impl Mirror {
         }
     }
 
-    /// Put every file that is new or changed since the pull; `key.txt` files last.
-    pub fn push(&self) -> io::Result<Pushed> {
+    /// Put every file that is new or changed since the pull; `key.txt` files last. Files
+    /// whose name starts with one of `local_only` (lock files) are not written.
+    pub fn push(&self, local_only: &[&str]) -> io::Result<Pushed> {
         let mut out = Pushed::default();
-        for rel in push_order(&self.local)? {
+        for rel in push_order(&self.local, local_only)? {
             let bytes = std::fs::read(self.local.join(&rel))?;
             if self.pulled.get(&rel) == Some(&xxh3_128(&bytes)) {
                 out.unchanged += 1;
@@ -110,11 +111,11 @@ fn scratch_folder() -> io::Result<PathBuf> {
     Ok(dir)
 }
 
-/// The files below `root` (relative, `/`-joined, lock files left out) in the order a push
-/// writes them: a session's `key.txt` after everything else.
-fn push_order(root: &Path) -> io::Result<Vec<String>> {
+/// The files below `root` (relative, `/`-joined, names starting with one of `local_only` left
+/// out) in the order a push writes them: a session's `key.txt` after everything else.
+fn push_order(root: &Path, local_only: &[&str]) -> io::Result<Vec<String>> {
     let mut files = Vec::new();
-    walk(root, root, &mut files)?;
+    walk(root, root, local_only, &mut files)?;
     files.sort_by_key(|rel| (rel.ends_with("/key.txt"), rel.clone()));
     Ok(files)
 }
@@ -124,17 +125,18 @@ fn safe_relative(rel: &str) -> bool {
         .all(|c| !c.is_empty() && c != "." && c != "..")
 }
 
-/// Relative `/`-joined paths of the files below `dir`, leaving out lock files.
-fn walk(root: &Path, dir: &Path, out: &mut Vec<String>) -> io::Result<()> {
+/// Relative `/`-joined paths of the files below `dir`, leaving out names that start with one
+/// of `local_only`.
+fn walk(root: &Path, dir: &Path, local_only: &[&str], out: &mut Vec<String>) -> io::Result<()> {
     for entry in std::fs::read_dir(dir)? {
         let entry = entry?;
         let path = entry.path();
         if entry.file_type()?.is_dir() {
-            walk(root, &path, out)?;
+            walk(root, &path, local_only, out)?;
             continue;
         }
         let name = entry.file_name().to_string_lossy().into_owned();
-        if name.starts_with(crate::run::lock::LOCK_FILE) {
+        if local_only.iter().any(|p| name.starts_with(p)) {
             continue;
         }
         if let Ok(rel) = path.strip_prefix(root) {
@@ -163,7 +165,7 @@ mod tests {
         }
         std::fs::write(root.join("p/.lock"), "held").expect("write");
         assert_eq!(
-            push_order(root).expect("walk"),
+            push_order(root, &[".lock"]).expect("walk"),
             [
                 "p/sessions/dataset=d/session=s/a.parquet",
                 "p/sessions/dataset=d/session=s/source.txt",
