@@ -16,16 +16,19 @@ use xxhash_rust::xxh3::Xxh3;
 
 use super::{count_fetched, split_url};
 
-fn runtime() -> &'static tokio::runtime::Runtime {
-    static RT: OnceLock<tokio::runtime::Runtime> = OnceLock::new();
+/// The process's runtime for store requests (an error when the OS refuses its thread).
+fn runtime() -> io::Result<&'static tokio::runtime::Runtime> {
+    static RT: OnceLock<Result<tokio::runtime::Runtime, String>> = OnceLock::new();
     RT.get_or_init(|| {
         tokio::runtime::Builder::new_multi_thread()
             .worker_threads(1)
             .thread_name("object-store")
             .enable_all()
             .build()
-            .expect("a Tokio runtime starts") // only fails when the OS refuses a thread
+            .map_err(|e| format!("cannot start the object-store runtime: {e}"))
     })
+    .as_ref()
+    .map_err(|e| io::Error::other(e.clone()))
 }
 
 /// The store of `url`'s bucket (built once per bucket) and the object's key.
@@ -73,7 +76,7 @@ pub struct RemoteObject {
 impl RemoteObject {
     pub fn open(url: &str) -> io::Result<RemoteObject> {
         let (store, path) = store_of(url)?;
-        let meta = runtime()
+        let meta = runtime()?
             .block_on(store.head(&path))
             .map_err(|e| match is_not_found(&e) {
                 true => io::Error::new(io::ErrorKind::NotFound, format!("{url}: no such object")),
@@ -94,7 +97,7 @@ impl RemoteObject {
             return Ok(Vec::new());
         }
         let range: Range<u64> = offset..offset + len;
-        let bytes = runtime()
+        let bytes = runtime()?
             .block_on(self.store.get_range(&self.path, range))
             .map_err(|e| store_error(&self.url, e))?;
         count_fetched(bytes.len() as u64);
@@ -138,7 +141,7 @@ impl RemoteObject {
 /// The whole object at `url`, or `None` when there is none.
 pub fn get(url: &str) -> io::Result<Option<Vec<u8>>> {
     let (store, path) = store_of(url)?;
-    runtime().block_on(async {
+    runtime()?.block_on(async {
         match store.get(&path).await {
             Ok(r) => {
                 let bytes = r.bytes().await.map_err(|e| store_error(url, e))?;
@@ -154,7 +157,7 @@ pub fn get(url: &str) -> io::Result<Option<Vec<u8>>> {
 /// Write `bytes` to `url` with one put (the object appears whole or not at all).
 pub fn put(url: &str, bytes: Vec<u8>) -> io::Result<()> {
     let (store, path) = store_of(url)?;
-    runtime()
+    runtime()?
         .block_on(store.put(&path, PutPayload::from(bytes)))
         .map(|_| ())
         .map_err(|e| store_error(url, e))
@@ -166,7 +169,7 @@ pub fn list(prefix: &str) -> io::Result<Vec<String>> {
     let (store, _) = store_of(&bucket)?;
     let listed =
         ObjectPath::parse(key.trim_end_matches('/')).map_err(|e| store_error(prefix, e))?;
-    let metas: Vec<object_store::ObjectMeta> = runtime()
+    let metas: Vec<object_store::ObjectMeta> = runtime()?
         .block_on(store.list(Some(&listed)).try_collect())
         .map_err(|e| store_error(prefix, e))?;
     let mut out: Vec<String> = metas
