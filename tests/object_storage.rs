@@ -171,11 +171,7 @@ fn run(env: &[(&str, String)], args: &[&str]) -> String {
         .args(args)
         .output()
         .expect("runs");
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let text = common::output_text(&o);
     assert!(o.status.success(), "run {args:?}: {text}");
     text
 }

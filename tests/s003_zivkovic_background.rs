@@ -300,11 +300,7 @@ fn run_output(pipeline: &Path, sessions: &str, out: &Path) -> (bool, String) {
         .arg(out)
         .output()
         .expect("runs");
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let text = crate::common::output_text(&o);
     (o.status.success(), text)
 }
 

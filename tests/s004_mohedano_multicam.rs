@@ -344,11 +344,7 @@ fn a_log_without_one_cameras_calibration_is_skipped_with_file_and_topic() {
     std::fs::copy(&good, bad_dir.join("good.mcap")).expect("copy");
     let out = f.root.join("bad_out2");
     let o = run(f, &out, &format!("{}/*.mcap", bad_dir.display()), &[], &[]);
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let text = common::output_text(&o);
     assert!(o.status.success(), "{text}");
     assert!(text.contains("1 computed"), "{text}");
     assert!(text.contains("1 skipped"), "{text}");

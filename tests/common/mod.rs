@@ -96,6 +96,15 @@ pub fn runner_sessions(dir: &Path) -> String {
     format!("{}/*/*.mcap", dir.display())
 }
 
+/// A finished command's stdout then stderr, as text (for assertions and their messages).
+pub fn output_text(o: &std::process::Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
 /// Every file under `out/<pipeline>/tables` and `figures`, with its bytes.
 pub fn products(out: &Path, pipeline: &str) -> BTreeMap<String, Vec<u8>> {
     let mut m = BTreeMap::new();
