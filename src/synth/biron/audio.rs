@@ -1,6 +1,7 @@
 //! The two microphone channels of a `biron_home` session under every acoustic condition of
 //! the grid (reverberation time × signal-to-noise ratio): each utterance's dry voice
-//! ([`super::speech`]) convolved with the image-source responses ([`super::room`]) from the
+//! ([`super::speech`]) convolved with the image-source responses ([`super::room`], the room's
+//! β calibrated so that its measured T20 is the condition's RT60) from the
 //! speaker's mouth (where it is when the utterance starts) to each microphone, summed, plus
 //! diffuse noise ([`super::noise`]) scaled to the condition's SNR, quantised to 16 bits.
 //!
@@ -131,7 +132,7 @@ pub fn render(script: &Script, stage: &Stage, setup: &AudioSetup, seed: u64) -> 
     let mut gain = None;
     let mut out = Vec::new();
     for &rt60 in &setup.rt60_s {
-        let room = Room::from_rt60(setup.room, rt60);
+        let room = Room::calibrated(setup.room, rt60, fs);
         let mut ch = [vec![0.0f64; n], vec![0.0f64; n]];
         for (x, mouth, at, _) in &dry {
             for (k, c) in ch.iter_mut().enumerate() {
