@@ -50,7 +50,53 @@ fn pure_fractional_delays_give_the_angle_within_a_tenth_of_a_degree() {
         let got = doa::cone_angle(d.tau_s, BIRON_SPACING_M).to_degrees();
         assert!((got - deg).abs() < 0.1, "{deg}°: got {got}°");
         assert!(d.peak > 0.9, "{deg}°: peak {}", d.peak);
-        assert_eq!(d.frames, 7, "the louder half of 14 frames");
+        assert_eq!(d.frames, 14, "every frame of the block");
+    }
+}
+
+#[test]
+fn every_phat_exponent_finds_a_pure_delay_of_coloured_noise_with_peak_one() {
+    // noise through a one-pole low-pass (energy falling with frequency, like a voice), then
+    // delayed exactly: the cross-spectrum's phase is the delay's whatever the weighting
+    let (w0, _) = delayed_noise(16_384, 0.0, 21);
+    let mut lp = Vec::with_capacity(w0.len());
+    let mut y = 0.0f32;
+    for v in &w0 {
+        y = 0.9 * y + v;
+        lp.push(y);
+    }
+    let n = lp.len();
+    let mut planner = RealFftPlanner::<f64>::new();
+    let (fwd, inv) = (planner.plan_fft_forward(n), planner.plan_fft_inverse(n));
+    let delay = 2.7;
+    let mut input: Vec<f64> = lp.iter().map(|&v| f64::from(v)).collect();
+    let mut spec = fwd.make_output_vec();
+    fwd.process(&mut input, &mut spec).expect("fft");
+    for (k, c) in spec.iter_mut().enumerate() {
+        let ph = -std::f64::consts::TAU * k as f64 * delay / n as f64;
+        *c *= Complex::new(ph.cos(), ph.sin());
+    }
+    spec[0].im = 0.0;
+    let last = spec.len() - 1;
+    spec[last] = Complex::new(0.0, 0.0);
+    let mut out = inv.make_output_vec();
+    inv.process(&mut spec, &mut out).expect("ifft");
+    let x1: Vec<f32> = out.iter().map(|&v| (v / n as f64) as f32).collect();
+    for beta in [0.0, 0.5, 0.7, 1.0] {
+        for share in [0.5, 1.0] {
+            let p = GccParams {
+                phat_beta: beta,
+                loud_share: share,
+                ..GccParams::default()
+            };
+            let mut g = GccPhat::new(p).expect("gcc");
+            let d = g.delay(block(&lp), block(&x1), 1e-3).expect("delay");
+            // PHAT's peak is sharp; the plain correlation (β = 0) of low-passed noise is broad
+            let tol = if beta == 0.0 { 0.1 } else { 0.02 };
+            assert!((d.tau_s * FS - delay).abs() < tol, "beta {beta}: {}", d.tau_s * FS);
+            assert!(d.peak > 0.95 && d.peak < 1.0 + 1e-9, "beta {beta}: peak {}", d.peak);
+            assert_eq!(d.frames, if share == 1.0 { 14 } else { 7 });
+        }
     }
 }
 
@@ -88,7 +134,7 @@ fn integer_lags_alone_err_by_up_to_the_quantisation_bound_and_no_more() {
     let params = GccParams {
         interp: 1,
         refine: Refine::Grid,
-        loud_half: false,
+        loud_share: 1.0,
         ..GccParams::default()
     };
     let mut g = GccPhat::new(params).expect("gcc");
@@ -130,9 +176,20 @@ fn bad_blocks_and_settings_are_errors() {
         g.delay(&[0.0; 100], &[0.0; 100], 1e-3),
         Err(GccError::Short { .. })
     ));
-    let bad = GccParams {
-        frame: 1000,
-        ..GccParams::default()
-    };
-    assert!(GccPhat::new(bad).is_err());
+    for bad in [
+        GccParams {
+            frame: 1000,
+            ..GccParams::default()
+        },
+        GccParams {
+            loud_share: 0.0,
+            ..GccParams::default()
+        },
+        GccParams {
+            phat_beta: 1.5,
+            ..GccParams::default()
+        },
+    ] {
+        assert!(GccPhat::new(bad).is_err(), "{bad:?}");
+    }
 }

@@ -15,14 +15,50 @@ use super::params::Params;
 use super::tables::DoaRow;
 use crate::audio::doa::{self, BIRON_SPACING_M};
 use crate::audio::gcc_phat::{GccParams, GccPhat};
-use crate::frames::audio::AudioStream;
+use crate::frames::Skips;
+use crate::frames::audio::{self, AudioStream};
 use crate::groundtruth::biron::UtteranceTruth;
+use crate::log::{SessionLog, TfBuffer};
+use crate::time::Nanos;
 
 /// The microphones' centre (world) and the robot's yaw.
 #[derive(Debug, Clone, Copy)]
 pub struct Mics {
     pub center: [f64; 3],
     pub yaw: f64,
+}
+
+impl Mics {
+    /// The microphones (`microphones` frame) and the robot's yaw (`base_link`) in `map` at `t`.
+    pub fn at(tf: &TfBuffer, t: Nanos) -> anyhow::Result<Mics> {
+        let mic = tf.lookup("map", "microphones", t)?;
+        let base = tf.lookup("map", "base_link", t)?;
+        Ok(Mics {
+            center: [mic.translation.x, mic.translation.y, mic.translation.z],
+            yaw: base.rotation.euler_angles().2,
+        })
+    }
+}
+
+/// Every `/audio_grid/…/audio` stream of a log, by topic.
+pub fn grid_streams(
+    log: &SessionLog,
+    skips: &mut Skips,
+) -> anyhow::Result<BTreeMap<String, AudioStream>> {
+    let mut out = BTreeMap::new();
+    let topics: Vec<String> = log
+        .summary()
+        .topics()
+        .into_iter()
+        .filter(|t| t.starts_with("/audio_grid/") && t.ends_with("/audio"))
+        .map(str::to_string)
+        .collect();
+    for topic in topics {
+        let (st, sk) = audio::read(log, &topic)?;
+        skips.merge(sk);
+        out.insert(topic, st);
+    }
+    Ok(out)
 }
 
 /// `(rt60 ms, snr dB)` of a grid topic `/audio_grid/rt60_<ms>ms_snr_<dB>db/audio`.
@@ -51,14 +87,16 @@ fn secs(ns: u64, t0: u64) -> f64 {
     ns.saturating_sub(t0) as f64 * 1e-9
 }
 
-/// Every scored block of every condition.
+/// Every scored block of every condition, located by GCC-PHAT with `gcc` (the system's own
+/// settings in the pipeline).
 pub fn blocks(
     grid: &BTreeMap<String, AudioStream>,
     utt: &[UtteranceTruth],
     mics: &Mics,
+    gcc: &GccParams,
     p: &Params,
 ) -> anyhow::Result<Vec<DoaRow>> {
-    let mut gcc = GccPhat::new(GccParams::default())?;
+    let mut gcc = GccPhat::new(*gcc)?;
     let max = GccPhat::max_lag_s(BIRON_SPACING_M);
     let mut out = Vec::new();
     for (topic, s) in grid {

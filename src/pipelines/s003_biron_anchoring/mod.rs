@@ -14,12 +14,12 @@
 //! ([`figures`]).
 
 mod aggregate;
-mod doa;
+pub mod doa;
 mod figures;
-mod params;
+pub mod params;
 mod score;
 mod session;
-mod tables;
+pub mod tables;
 
 use std::collections::BTreeMap;
 

@@ -6,7 +6,6 @@
 //! direction-of-arrival blocks of every acoustic condition and the correlogram
 //! ([`super::doa`]), cached as the rows of [`super::tables`].
 
-use std::collections::BTreeMap;
 
 use anyhow::Context;
 use image::RgbImage;
@@ -19,7 +18,7 @@ use crate::anchoring::fusion::LegTrack;
 use crate::anchoring::system::{LegFront, SoundFront, Spoken, StepInput, System, SystemParams};
 use crate::anchoring::view::CameraView;
 use crate::frames::Skips;
-use crate::frames::audio::{self, AudioStream};
+use crate::frames::audio;
 use crate::frames::laser::{LaserOptions, scans};
 use crate::frames::{camera, truth};
 use crate::geometry::camera::CameraModel;
@@ -225,14 +224,9 @@ pub fn process(
     bar.set_message("scores");
     let mut out = score::tables(&frames, &logged, p)?;
     bar.set_message("direction of arrival");
-    let grid = grid_streams(log, &mut skips)?;
-    let mic = tf.lookup("map", "microphones", t0)?;
-    let base = tf.lookup("map", "base_link", t0)?;
-    let mics = super::doa::Mics {
-        center: [mic.translation.x, mic.translation.y, mic.translation.z],
-        yaw: base.rotation.euler_angles().2,
-    };
-    let doa_rows = super::doa::blocks(&grid, &utt, &mics, p)?;
+    let grid = super::doa::grid_streams(log, &mut skips)?;
+    let mics = super::doa::Mics::at(&tf, t0)?;
+    let doa_rows = super::doa::blocks(&grid, &utt, &mics, &sys_params.gcc, p)?;
     out.insert(t::DOA.into(), super::tables::DoaRow::frame(&doa_rows)?);
     let gram: RgbImage = super::doa::correlogram(&nominal, &utt, &mics, p)?;
     out.insert(
@@ -260,23 +254,3 @@ fn detect(det: &mut FaceDetector, rgb: &RgbImage) -> anyhow::Result<Vec<Face>> {
     Ok(det.detect(view)?)
 }
 
-/// Every acoustic condition's stream (topics under `/audio_grid/`).
-fn grid_streams(
-    log: &SessionLog,
-    skips: &mut Skips,
-) -> anyhow::Result<BTreeMap<String, AudioStream>> {
-    let mut out = BTreeMap::new();
-    let topics: Vec<String> = log
-        .summary()
-        .topics()
-        .into_iter()
-        .filter(|t| t.starts_with("/audio_grid/") && t.ends_with("/audio"))
-        .map(str::to_string)
-        .collect();
-    for topic in topics {
-        let (st, sk) = audio::read(log, &topic)?;
-        skips.merge(sk);
-        out.insert(topic, st);
-    }
-    Ok(out)
-}
