@@ -29,6 +29,7 @@ mod real_logs;
 mod roundtrip;
 mod s000_cielniak_omni;
 mod s001_kobilarov_following;
+mod s003_biron_anchoring;
 mod s003_zivkovic_background;
 mod s004_mohedano_multicam;
 mod score_cli;
