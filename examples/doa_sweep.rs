@@ -6,7 +6,7 @@
 //!
 //! Usage: `cargo run --release --example doa_sweep -- LOG.mcap... [NAME:key=value,...]...`
 //! with keys `band_lo`, `band_hi`, `frame`, `hop`, `loud_share`, `phat_beta`; the system's
-//! default settings are always the first row.
+//! default settings are always the first row. `DUMP=NAME` prints that variant's every block.
 
 use std::collections::BTreeMap;
 
@@ -19,7 +19,9 @@ use peopletrack::pipelines::s003_biron_anchoring::doa::{Mics, blocks, grid_strea
 use peopletrack::pipelines::s003_biron_anchoring::params::Params;
 
 fn variant(spec: &str, base: GccParams) -> Result<(String, GccParams), String> {
-    let (name, kv) = spec.split_once(':').ok_or(format!("{spec}: NAME:key=value,..."))?;
+    let (name, kv) = spec
+        .split_once(':')
+        .ok_or(format!("{spec}: NAME:key=value,..."))?;
     let mut g = base;
     for pair in kv.split(',').filter(|s| !s.is_empty()) {
         let (k, v) = pair.split_once('=').ok_or(format!("{pair}: key=value"))?;
@@ -79,7 +81,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 if std::env::var("DUMP").is_ok_and(|d| d == variants[i].0) {
                     println!(
                         "dump {path} {} {} t {:.1} spk {} true {:.2} est {:.2} peak {:.3}",
-                        r.rt60_ms, r.snr_db, r.t_s, r.speaker, r.true_cone_deg, r.est_cone_deg, r.peak
+                        r.rt60_ms,
+                        r.snr_db,
+                        r.t_s,
+                        r.speaker,
+                        r.true_cone_deg,
+                        r.est_cone_deg,
+                        r.peak
                     );
                 }
                 errs.entry((i, r.rt60_ms, r.snr_db))

@@ -48,7 +48,11 @@ fn run(sessions: &str, out: &Path, jobs: &str) {
 }
 
 fn rows(out: &Path, table: &str) -> Vec<BTreeMap<String, String>> {
-    crate::common::csv(&out.join(PIPELINE).join("tables").join(format!("{table}.csv")))
+    crate::common::csv(
+        &out.join(PIPELINE)
+            .join("tables")
+            .join(format!("{table}.csv")),
+    )
 }
 
 fn num(r: &BTreeMap<String, String>, col: &str) -> f64 {

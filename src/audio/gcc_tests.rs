@@ -93,8 +93,16 @@ fn every_phat_exponent_finds_a_pure_delay_of_coloured_noise_with_peak_one() {
             let d = g.delay(block(&lp), block(&x1), 1e-3).expect("delay");
             // PHAT's peak is sharp; the plain correlation (β = 0) of low-passed noise is broad
             let tol = if beta == 0.0 { 0.1 } else { 0.02 };
-            assert!((d.tau_s * FS - delay).abs() < tol, "beta {beta}: {}", d.tau_s * FS);
-            assert!(d.peak > 0.95 && d.peak < 1.0 + 1e-9, "beta {beta}: peak {}", d.peak);
+            assert!(
+                (d.tau_s * FS - delay).abs() < tol,
+                "beta {beta}: {}",
+                d.tau_s * FS
+            );
+            assert!(
+                d.peak > 0.95 && d.peak < 1.0 + 1e-9,
+                "beta {beta}: peak {}",
+                d.peak
+            );
             assert_eq!(d.frames, if share == 1.0 { 14 } else { 7 });
         }
     }

@@ -6,7 +6,6 @@
 //! direction-of-arrival blocks of every acoustic condition and the correlogram
 //! ([`super::doa`]), cached as the rows of [`super::tables`].
 
-
 use anyhow::Context;
 use image::RgbImage;
 
@@ -253,4 +252,3 @@ fn detect(det: &mut FaceDetector, rgb: &RgbImage) -> anyhow::Result<Vec<Face>> {
     let view = ImageView::new(&grey, rgb.width() as usize, rgb.height() as usize, 1)?;
     Ok(det.detect(view)?)
 }
-

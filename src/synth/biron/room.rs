@@ -263,17 +263,28 @@ mod tests {
         assert!((t - tau * 1e6f64.ln()).abs() < 1e-3, "{t}");
         assert_eq!(schroeder_t20(&[0.0; 10], FS), None);
         assert_eq!(schroeder_t20(&[], FS), None);
-        assert_eq!(schroeder_t20(&[1.0, 1.0, 1.0], FS), None, "never falls 25 dB");
+        assert_eq!(
+            schroeder_t20(&[1.0, 1.0, 1.0], FS),
+            None,
+            "never falls 25 dB"
+        );
     }
 
     #[test]
     fn a_calibrated_room_measures_the_asked_reverberation_time_with_a_smaller_beta_than_sabine() {
-        for (size, rt) in [([6.0, 5.0, 2.7], 0.3), ([7.0, 6.0, 2.6], 0.3), ([7.0, 6.0, 2.6], 0.6)] {
+        for (size, rt) in [
+            ([6.0, 5.0, 2.7], 0.3),
+            ([7.0, 6.0, 2.6], 0.3),
+            ([7.0, 6.0, 2.6], 0.6),
+        ] {
             let sabine = Room::from_rt60(size, rt);
             let room = Room::calibrated(size, rt, FS);
             let (src, mic) = reference_pair(size);
             let t = schroeder_t20(&room.rir(src, mic, FS), FS).expect("decays");
-            eprintln!("{size:?} {rt} s: beta {:.4} (Sabine {:.4}), T20 {t:.4} s", room.beta, sabine.beta);
+            eprintln!(
+                "{size:?} {rt} s: beta {:.4} (Sabine {:.4}), T20 {t:.4} s",
+                room.beta, sabine.beta
+            );
             assert!((t / rt - 1.0).abs() < 0.005, "{size:?} {rt}: T20 {t}");
             assert!(room.beta < sabine.beta);
             assert_eq!(room.rt60_s, rt);
