@@ -17,7 +17,7 @@ mod aggregate;
 pub mod doa;
 mod figures;
 pub mod params;
-mod score;
+pub mod score;
 mod session;
 pub mod tables;
 
