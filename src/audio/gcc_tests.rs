@@ -6,16 +6,14 @@ use crate::rng;
 
 const FS: f64 = 16_000.0;
 
-/// White noise of `n` samples (a power of two) and the same noise delayed by `delay`
-/// samples (circularly, by a phase ramp: an exact fractional delay), as microphones 0 and 1.
-fn delayed_noise(n: usize, delay: f64, seed: u64) -> (Vec<f32>, Vec<f32>) {
-    let x: Vec<f64> = (0..n)
-        .map(|i| f64::from(rng::gauss(rng::hash(seed, &[i as u64]))))
-        .collect();
+/// `x` (length a power of two) delayed by `delay` samples circularly, by a phase ramp: an
+/// exact fractional delay.
+fn delayed(x: &[f64], delay: f64) -> Vec<f32> {
+    let n = x.len();
     let mut planner = RealFftPlanner::<f64>::new();
     let fwd = planner.plan_fft_forward(n);
     let inv = planner.plan_fft_inverse(n);
-    let mut input = x.clone();
+    let mut input = x.to_vec();
     let mut spec = fwd.make_output_vec();
     fwd.process(&mut input, &mut spec).expect("fft");
     for (k, c) in spec.iter_mut().enumerate() {
@@ -27,9 +25,17 @@ fn delayed_noise(n: usize, delay: f64, seed: u64) -> (Vec<f32>, Vec<f32>) {
     spec[last] = Complex::new(0.0, 0.0);
     let mut y = inv.make_output_vec();
     inv.process(&mut spec, &mut y).expect("ifft");
+    y.iter().map(|&v| (v / n as f64) as f32).collect()
+}
+
+/// White noise of `n` samples (a power of two) and the same noise [`delayed`] by `delay`
+/// samples, as microphones 0 and 1.
+fn delayed_noise(n: usize, delay: f64, seed: u64) -> (Vec<f32>, Vec<f32>) {
+    let x: Vec<f64> = (0..n)
+        .map(|i| f64::from(rng::gauss(rng::hash(seed, &[i as u64]))))
+        .collect();
     let x0 = x.iter().map(|&v| v as f32).collect();
-    let x1 = y.iter().map(|&v| (v / n as f64) as f32).collect();
-    (x0, x1)
+    (x0, delayed(&x, delay))
 }
 
 fn block(x: &[f32]) -> &[f32] {
@@ -65,23 +71,8 @@ fn every_phat_exponent_finds_a_pure_delay_of_coloured_noise_with_peak_one() {
         y = 0.9 * y + v;
         lp.push(y);
     }
-    let n = lp.len();
-    let mut planner = RealFftPlanner::<f64>::new();
-    let (fwd, inv) = (planner.plan_fft_forward(n), planner.plan_fft_inverse(n));
     let delay = 2.7;
-    let mut input: Vec<f64> = lp.iter().map(|&v| f64::from(v)).collect();
-    let mut spec = fwd.make_output_vec();
-    fwd.process(&mut input, &mut spec).expect("fft");
-    for (k, c) in spec.iter_mut().enumerate() {
-        let ph = -std::f64::consts::TAU * k as f64 * delay / n as f64;
-        *c *= Complex::new(ph.cos(), ph.sin());
-    }
-    spec[0].im = 0.0;
-    let last = spec.len() - 1;
-    spec[last] = Complex::new(0.0, 0.0);
-    let mut out = inv.make_output_vec();
-    inv.process(&mut spec, &mut out).expect("ifft");
-    let x1: Vec<f32> = out.iter().map(|&v| (v / n as f64) as f32).collect();
+    let x1 = delayed(&lp.iter().map(|&v| f64::from(v)).collect::<Vec<_>>(), delay);
     for beta in [0.0, 0.5, 0.7, 1.0] {
         for share in [0.5, 1.0] {
             let p = GccParams {
