@@ -75,14 +75,12 @@ fn fixture() -> &'static Fixture {
 }
 
 fn run(f: &Fixture, out: &Path, jobs: &str) -> std::process::Output {
-    Command::cargo_bin("peopletrack")
-        .expect("binary")
-        .args(["-j", jobs, "run"])
-        .arg(root().join("pipelines/s001_kobilarov_following.toml"))
-        .args(["--sessions", &f.sessions, "--out"])
-        .arg(out)
-        .output()
-        .expect("runs")
+    crate::common::run_pipeline(
+        &root().join("pipelines/s001_kobilarov_following.toml"),
+        &f.sessions,
+        out,
+        jobs,
+    )
 }
 
 fn tables(out: &Path) -> BTreeMap<String, Vec<u8>> {

@@ -15,7 +15,6 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
 use peopletrack::synth::{SynthOptions, synthesize};
 
 const PIPELINE: &str = "s003_biron_anchoring";
@@ -36,14 +35,7 @@ fn run(sessions: &str, out: &Path, jobs: &str) {
     let pipeline = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("pipelines")
         .join(format!("{PIPELINE}.toml"));
-    let o = Command::cargo_bin("peopletrack")
-        .expect("binary")
-        .args(["-j", jobs, "run"])
-        .arg(&pipeline)
-        .args(["--sessions", sessions, "--out"])
-        .arg(out)
-        .output()
-        .expect("runs");
+    let o = crate::common::run_pipeline(&pipeline, sessions, out, jobs);
     assert!(o.status.success(), "{}", crate::common::output_text(&o));
 }
 

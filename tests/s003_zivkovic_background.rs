@@ -113,14 +113,7 @@ fn synth(dir: &Path) -> PathBuf {
 }
 
 fn run(pipeline: &Path, sessions: &str, out: &Path, jobs: &str) {
-    let o = Command::cargo_bin("peopletrack")
-        .expect("binary")
-        .args(["-j", jobs, "run"])
-        .arg(pipeline)
-        .args(["--sessions", sessions, "--out"])
-        .arg(out)
-        .output()
-        .expect("runs");
+    let o = crate::common::run_pipeline(pipeline, sessions, out, jobs);
     assert!(
         o.status.success(),
         "{}\n{}",

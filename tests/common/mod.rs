@@ -96,6 +96,22 @@ pub fn runner_sessions(dir: &Path) -> String {
     format!("{}/*/*.mcap", dir.display())
 }
 
+/// `peopletrack -j JOBS run PIPELINE --sessions SESSIONS --out OUT`, its output (not checked).
+pub fn run_pipeline(
+    pipeline: &Path,
+    sessions: &str,
+    out: &Path,
+    jobs: &str,
+) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_peopletrack"))
+        .args(["-j", jobs, "run"])
+        .arg(pipeline)
+        .args(["--sessions", sessions, "--out"])
+        .arg(out)
+        .output()
+        .expect("peopletrack runs")
+}
+
 /// A finished command's stdout then stderr, as text (for assertions and their messages).
 pub fn output_text(o: &std::process::Output) -> String {
     format!(
