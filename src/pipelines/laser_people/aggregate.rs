@@ -11,6 +11,7 @@ use std::path::PathBuf;
 use super::classifier;
 use super::fp_causes::{self, FpCauseRow};
 use super::methods::Method;
+use super::paper;
 use super::params::{Params, Sequence};
 use super::tables::{self, ScanRow, SessionRow, TrackRow, TruthRow};
 use crate::eval::mot::{EventKind, Geometry, GroundPoint, MatchRule, Observation, evaluate};
@@ -376,6 +377,7 @@ pub(super) fn run(
             fp_causes::STATIC_EXTENT_M
         )),
     );
+    paper::products(p, &results, &mut out)?;
     classifier::products(p, &mut out)?;
     Ok((out, data, results))
 }

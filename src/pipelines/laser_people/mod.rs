@@ -9,7 +9,8 @@
 //! sequence's protocol ([`params::Sequence`]: scored scans, bearing wedge, range), runs paired
 //! t-tests of the methods' position errors, writes the tracks as CSV, draws the figures
 //! ([`figures`]: a top view per sequence, MOTA and MOTP per method; from the poses and sampled
-//! returns that [`view`] caches), and with `--write-tracks` writes the tracks back into copies
+//! returns that [`view`] caches), puts the real sequences beside the paper's Table III under
+//! the paper's own protocol for each benchmark ([`paper`]), and with `--write-tracks` writes the tracks back into copies
 //! of the logs as Foxglove markers ([`markers`]). The real sequences
 //! (Leigh et al., ICRA 2015) are read in place from `../shared/real/laser/`; listed ones that
 //! are absent get SKIPPED rows.
@@ -21,6 +22,7 @@ mod fp_causes;
 pub mod learned;
 mod markers;
 mod methods;
+mod paper;
 mod params;
 mod session;
 mod tables;

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::learned::LearnedParams;
 use super::methods::Method;
+use super::paper::PaperBenchmark;
 use crate::groundtruth::PEOPLE_TOPIC;
 use crate::laser::training::FeatureSet;
 use crate::run::config::Invalid;
@@ -42,6 +43,11 @@ pub struct Sequence {
     /// `general_tracking_moving_1`).
     #[serde(default = "yes")]
     pub publish_occluded: bool,
+    /// The benchmark of Leigh et al. (ICRA 2015, Table II) this sequence belongs to: its
+    /// rows of Table III and this run's rows under its protocol go into `paper_table3`
+    /// ([`super::paper`]); absent: none.
+    #[serde(default)]
+    pub paper_benchmark: Option<PaperBenchmark>,
 }
 
 fn yes() -> bool {
@@ -104,6 +110,7 @@ impl Default for Params {
                 max_range_m: None,
                 withhold_odometry: false,
                 publish_occluded: true,
+                paper_benchmark: None,
             },
             methods: vec![Method::Legs, Method::Nearest],
             learned: LearnedParams::default(),
