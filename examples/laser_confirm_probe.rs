@@ -1,0 +1,304 @@
+//! Why the free-space tracker reports people late (issue 35): on a **synthetic** laser log
+//! (never a scored real one), every scan on which a ground-truth person is in the scored area
+//! (in front of the laser, within 5 m) but no reported person lies within 0.75 m of them is
+//! put down to the first blocking reason that applies, looking at the tracker's object tracks
+//! within 0.4 m of the person:
+//!
+//! - `no_leg`: the leg model found no leg of theirs on the scan;
+//! - `no_track`: legs found, but no object track near them;
+//! - `low_confidence`: tracks, but none with running confidence ≥ 0.1 (they cannot pair);
+//! - `not_free`: confident tracks, none in free space (running free value ≥ 0.06);
+//! - `one_leg`: fewer than two confident tracks near them (the legs are one cluster, or one
+//!   is hidden or not found);
+//! - `short_travel`: two confident tracks, one free, but none travelled 0.5 m yet;
+//! - `other`: all of that holds and the pair is still not a person (pairing distance, both
+//!   legs matched on the scan, the quick rule's conditions).
+//!
+//! Prints the counts per rule (leg_tracker's alone, with the default quick rule) and the
+//! delay from a person's first scored scan to their first reported one.
+//!
+//! Usage: `cargo run --release --example laser_confirm_probe -- LOG.mcap …`
+
+use std::collections::BTreeMap;
+
+use nalgebra::{Isometry3, Point2, Point3};
+use peopletrack::frames::laser::{LaserOptions, scans};
+use peopletrack::frames::truth;
+use peopletrack::laser::joint::JointParams;
+use peopletrack::laser::legs::{self, LegParams};
+use peopletrack::laser::occupancy::GridParams;
+use peopletrack::laser::people::FreeSpaceTracker;
+use peopletrack::laser::points::{self, ScanGeometry};
+use peopletrack::laser::segment::{self, SegmentOptions};
+use peopletrack::log::SessionLog;
+
+type Res<T> = Result<T, Box<dyn std::error::Error>>;
+
+struct Scan {
+    time_s: f64,
+    ranges: Vec<f32>,
+    geometry: ScanGeometry,
+    /// Ground truth in the map frame, with whether it is scored.
+    truth: Vec<(i64, Point2<f64>, bool)>,
+    pose: Isometry3<f64>,
+}
+
+fn to_laser(pose: &Isometry3<f64>, p: Point2<f64>) -> Point2<f64> {
+    let q = pose.inverse_transform_point(&Point3::new(p.x, p.y, 0.0));
+    Point2::new(q.x, q.y)
+}
+
+fn load(path: &str) -> Res<Vec<Scan>> {
+    let log = SessionLog::open(path)?;
+    let (gt, _) = truth::people(&log, "/ground_truth/people")?;
+    let options = LaserOptions {
+        fixed_frame: Some("map".into()),
+        ..LaserOptions::default()
+    };
+    let mut out = Vec::new();
+    let mut t0 = None;
+    for f in scans(&log, "/scan", &options)? {
+        let f = f?;
+        let Some(pose) = f.pose else { continue };
+        let t0 = *t0.get_or_insert(f.stamp);
+        let truth = gt
+            .nearest(f.stamp, 50_000_000)
+            .map(|fr| {
+                fr.people
+                    .iter()
+                    .map(|p| {
+                        let w = Point2::new(p.x, p.y);
+                        let l = to_laser(&pose, w);
+                        (i64::from(p.id), w, l.x >= 0.0 && l.coords.norm() <= 5.0)
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        out.push(Scan {
+            time_s: f.stamp.signed_sub(t0) as f64 * 1e-9,
+            geometry: ScanGeometry::of(&f.scan),
+            ranges: f.scan.ranges.clone(),
+            truth,
+            pose,
+        });
+    }
+    Ok(out)
+}
+
+const REASONS: [&str; 7] = [
+    "no_leg",
+    "no_track",
+    "low_confidence",
+    "not_free",
+    "one_leg",
+    "short_travel",
+    "other",
+];
+
+fn describe(t: f64, id: i64, w: Point2<f64>, objects: &[&peopletrack::laser::joint::Track], why: &str) {
+    let f: Vec<String> = objects
+        .iter()
+        .map(|o| {
+            format!(
+                "[#{} d {:.2} conf {:.2} free {:.3} trav {:.2} seen {}]",
+                o.id,
+                (o.position() - w).norm(),
+                o.confidence,
+                o.free,
+                o.travelled_m,
+                o.seen
+            )
+        })
+        .collect();
+    println!("    {why} t {t:.1} person {id}: {}", f.join(" "));
+}
+
+/// Blocking-reason counts and per-person delays (s) of one rule on one log.
+fn probe(scans: &[Scan], params: JointParams) -> (BTreeMap<&'static str, u64>, Vec<f64>, u64) {
+    let mut fs = FreeSpaceTracker::new(params, GridParams::default());
+    let mut reasons: BTreeMap<&'static str, u64> = REASONS.iter().map(|r| (*r, 0)).collect();
+    let mut first_seen: BTreeMap<i64, f64> = BTreeMap::new();
+    let mut first_reported: BTreeMap<i64, f64> = BTreeMap::new();
+    let mut scored = 0;
+    let mut last: BTreeMap<i64, (f64, Point2<f64>)> = BTreeMap::new();
+    for s in scans {
+        let pts = points::project(&s.ranges, &s.geometry, Some(&s.pose));
+        let segs = segment::segment(&pts, &SegmentOptions::default());
+        let d = legs::detect(
+            &pts,
+            &segs,
+            s.ranges.len(),
+            Some(&s.pose),
+            &LegParams::default(),
+        );
+        fs.step(
+            s.time_s,
+            &d,
+            &[],
+            &pts,
+            &s.ranges,
+            &s.geometry,
+            Some(&s.pose),
+        );
+        let p = fs.tracker.params;
+        for &(id, w, ok) in &s.truth {
+            let prev = last.insert(id, (s.time_s, w));
+            let last: BTreeMap<i64, (f64, Point2<f64>)> = prev.into_iter().map(|v| (id, v)).collect();
+            if !ok {
+                continue;
+            }
+            scored += 1;
+            first_seen.entry(id).or_insert(s.time_s);
+            if fs
+                .tracker
+                .confirmed()
+                .any(|t| (t.position() - w).norm() <= 0.75)
+            {
+                first_reported.entry(id).or_insert(s.time_s);
+                continue;
+            }
+            let near = |q: Point2<f64>| (q - w).norm() <= 0.4;
+            let objects: Vec<_> = fs
+                .tracker
+                .tracks()
+                .iter()
+                .filter(|t| !t.person && near(t.position()))
+                .collect();
+            let reason = if !d.legs.iter().any(|l| near(l.fixed)) {
+                "no_leg"
+            } else if objects.is_empty() {
+                "no_track"
+            } else if !objects.iter().any(|t| t.confidence >= p.min_confidence) {
+                "low_confidence"
+            } else if !objects
+                .iter()
+                .any(|t| t.confidence >= p.min_confidence && t.free < p.free_threshold)
+            {
+                if std::env::var("PROBE_VERBOSE").is_ok() {
+                    let speed = last
+                        .get(&id)
+                        .map_or(f64::NAN, |(t0, w0): &(f64, Point2<f64>)| {
+                            (w - w0).norm() / (s.time_s - t0)
+                        });
+                    let f: Vec<String> = objects
+                        .iter()
+                        .map(|t| format!("{:.3}", t.free))
+                        .collect();
+                    let here = fs.grid.occupancy_around(w);
+                    println!(
+                        "    t {:.1} person {id} speed {speed:.2} m/s, grid at person {here:.3}, track free {}",
+                        s.time_s,
+                        f.join(" ")
+                    );
+                }
+                "not_free"
+            } else if objects
+                .iter()
+                .filter(|t| t.confidence >= p.min_confidence)
+                .count()
+                < 2
+            {
+                if std::env::var("PROBE_VERBOSE").is_ok() {
+                    describe(s.time_s, id, w, &objects, "one_leg");
+                }
+                "one_leg"
+            } else if !objects.iter().any(|t| t.travelled_m > p.min_travel_m) {
+                if std::env::var("PROBE_VERBOSE").is_ok() {
+                    describe(s.time_s, id, w, &objects, "short_travel");
+                }
+                "short_travel"
+            } else {
+                if std::env::var("PROBE_VERBOSE").is_ok() {
+                    describe(s.time_s, id, w, &objects, "other");
+                }
+                "other"
+            };
+            *reasons.entry(reason).or_default() += 1;
+        }
+    }
+    let delays = first_seen
+        .iter()
+        .map(|(id, t0)| first_reported.get(id).map_or(f64::INFINITY, |t| t - t0))
+        .collect();
+    (reasons, delays, scored)
+}
+
+/// A real log of Leigh et al. with its `ground_truth.csv` beside it (laser-frame positions on
+/// scan indices), scored on `scans` and within the bearing `wedge` (degrees), as the pipeline
+/// file scores `general_tracking_moving_1`. Diagnosis only: nothing is chosen from it.
+fn load_real(path: &str, scans_window: [usize; 2], wedge: [f64; 2]) -> Res<Vec<Scan>> {
+    let log = SessionLog::open(path)?;
+    let csv = std::fs::read_to_string(std::path::Path::new(path).with_file_name("ground_truth.csv"))?;
+    let mut gt: BTreeMap<usize, Vec<(i64, Point2<f64>)>> = BTreeMap::new();
+    for l in csv.lines().filter(|l| !l.starts_with('#')) {
+        let f: Vec<&str> = l.split(',').collect();
+        gt.entry(f[0].parse()?)
+            .or_default()
+            .push((f[2].parse()?, Point2::new(f[3].parse()?, f[4].parse()?)));
+    }
+    let mut out = Vec::new();
+    let mut t0 = None;
+    for (k, f) in scans(&log, "/scan", &LaserOptions::default())?.enumerate() {
+        let f = f?;
+        let pose = f.pose.unwrap_or_else(Isometry3::identity);
+        let t0 = *t0.get_or_insert(f.stamp);
+        let in_window = k >= scans_window[0] && k <= scans_window[1];
+        let truth = gt
+            .get(&k)
+            .map(|v| {
+                v.iter()
+                    .map(|(id, l)| {
+                        let a = l.y.atan2(l.x).to_degrees();
+                        let w = pose.transform_point(&Point3::new(l.x, l.y, 0.0));
+                        (*id, Point2::new(w.x, w.y), in_window && a >= wedge[0] && a <= wedge[1])
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        out.push(Scan {
+            time_s: f.stamp.signed_sub(t0) as f64 * 1e-9,
+            geometry: ScanGeometry::of(&f.scan),
+            ranges: f.scan.ranges.clone(),
+            truth,
+            pose,
+        });
+    }
+    Ok(out)
+}
+
+fn main() -> Res<()> {
+    let paths: Vec<String> = std::env::args().skip(1).collect();
+    if paths.is_empty() {
+        return Err("usage: laser_confirm_probe LOG.mcap …".into());
+    }
+    let rules = [
+        ("leg_tracker", JointParams::leg_tracker()),
+        ("default (quick)", JointParams::default()),
+    ];
+    for path in &paths {
+        let scans = if path.contains("general_tracking_moving_1") {
+            load_real(path, [133, 404], [-80.0, 12.0])?
+        } else {
+            load(path)?
+        };
+        for (name, params) in rules {
+            let (reasons, mut delays, scored) = probe(&scans, params);
+            delays.sort_by(f64::total_cmp);
+            let missed: u64 = reasons.values().sum();
+            let never = delays.iter().filter(|d| d.is_infinite()).count();
+            let finite: Vec<String> = delays
+                .iter()
+                .filter(|d| d.is_finite())
+                .map(|d| format!("{d:.1}"))
+                .collect();
+            println!(
+                "{path} [{name}]: {scored} scored positions, {missed} without a reported person; {} people, {never} never reported; delays (s) {}",
+                delays.len(),
+                finite.join(" ")
+            );
+            let parts: Vec<String> = reasons.iter().map(|(k, v)| format!("{k} {v}")).collect();
+            println!("  blocking: {}", parts.join(", "));
+        }
+    }
+    Ok(())
+}
