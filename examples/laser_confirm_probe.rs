@@ -14,17 +14,23 @@
 //! - `other`: all of that holds and the pair is still not a person (pairing distance, both
 //!   legs matched on the scan, the quick rule's conditions).
 //!
-//! Prints the counts per rule (leg_tracker's alone, with the default quick rule) and the
-//! delay from a person's first scored scan to their first reported one.
+//! Prints the counts per rule (leg_tracker's alone, the default quick rule, and the quick
+//! rule with the lone-cluster option), the delay from a person's first scored scan to their
+//! first reported one, and CLEAR MOT at 0.75 m over the scored positions (the pipeline's
+//! protocol: synthetic in front of the laser within 5 m; `general_tracking_moving_1` read with
+//! its `ground_truth.csv`, scans 133..404, bearings −80..12°, for diagnosis only).
 //!
 //! Usage: `cargo run --release --example laser_confirm_probe -- LOG.mcap …`
+//! (`PROBE_VERBOSE=1`: every blocked position with the tracks near it; `PROBE_FP=1`: the
+//! tracks with the most false positives).
 
 use std::collections::BTreeMap;
 
 use nalgebra::{Isometry3, Point2, Point3};
+use peopletrack::eval::mot::{Geometry, GroundPoint, MatchRule, Observation, evaluate};
 use peopletrack::frames::laser::{LaserOptions, scans};
 use peopletrack::frames::truth;
-use peopletrack::laser::joint::JointParams;
+use peopletrack::laser::joint::{JointParams, LONE};
 use peopletrack::laser::legs::{self, LegParams};
 use peopletrack::laser::occupancy::GridParams;
 use peopletrack::laser::people::FreeSpaceTracker;
@@ -41,6 +47,27 @@ struct Scan {
     /// Ground truth in the map frame, with whether it is scored.
     truth: Vec<(i64, Point2<f64>, bool)>,
     pose: Isometry3<f64>,
+    /// Scored area in the laser frame: `None` = the synthetic one (in front, ≤ 5 m); else
+    /// this scan is in the window and hypotheses are kept within the bearing wedge (degrees).
+    area: Area,
+}
+
+#[derive(Clone, Copy)]
+enum Area {
+    Synthetic,
+    Real { in_window: bool, wedge: [f64; 2] },
+}
+
+impl Area {
+    fn keeps(self, l: Point2<f64>) -> bool {
+        match self {
+            Area::Synthetic => l.x >= 0.0 && l.coords.norm() <= 5.0,
+            Area::Real { in_window, wedge } => {
+                let a = l.y.atan2(l.x).to_degrees();
+                in_window && a >= wedge[0] && a <= wedge[1]
+            }
+        }
+    }
 }
 
 fn to_laser(pose: &Isometry3<f64>, p: Point2<f64>) -> Point2<f64> {
@@ -80,6 +107,7 @@ fn load(path: &str) -> Res<Vec<Scan>> {
             ranges: f.scan.ranges.clone(),
             truth,
             pose,
+            area: Area::Synthetic,
         });
     }
     Ok(out)
@@ -113,15 +141,30 @@ fn describe(t: f64, id: i64, w: Point2<f64>, objects: &[&peopletrack::laser::joi
     println!("    {why} t {t:.1} person {id}: {}", f.join(" "));
 }
 
+/// Blocking-reason counts, per-person delays (s), scored positions and CLEAR MOT at 0.75 m
+/// ([FP, FN, IDSW, GT]) of one rule on one log.
+type Probe = (BTreeMap<&'static str, u64>, Vec<f64>, u64, [u64; 4]);
+
+fn point(frame: i64, id: i64, p: Point2<f64>) -> Observation {
+    Observation {
+        frame,
+        id,
+        geometry: Geometry::Point(GroundPoint { x_m: p.x, y_m: p.y }),
+        confidence: 1.0,
+    }
+}
+
 /// Blocking-reason counts and per-person delays (s) of one rule on one log.
-fn probe(scans: &[Scan], params: JointParams) -> (BTreeMap<&'static str, u64>, Vec<f64>, u64) {
+fn probe(scans: &[Scan], params: JointParams) -> Probe {
     let mut fs = FreeSpaceTracker::new(params, GridParams::default());
     let mut reasons: BTreeMap<&'static str, u64> = REASONS.iter().map(|r| (*r, 0)).collect();
     let mut first_seen: BTreeMap<i64, f64> = BTreeMap::new();
     let mut first_reported: BTreeMap<i64, f64> = BTreeMap::new();
     let mut scored = 0;
     let mut last: BTreeMap<i64, (f64, Point2<f64>)> = BTreeMap::new();
-    for s in scans {
+    let (mut gt, mut hyp) = (Vec::new(), Vec::new());
+    for (frame, s) in scans.iter().enumerate() {
+        let frame = frame as i64;
         let pts = points::project(&s.ranges, &s.geometry, Some(&s.pose));
         let segs = segment::segment(&pts, &SegmentOptions::default());
         let d = legs::detect(
@@ -141,7 +184,16 @@ fn probe(scans: &[Scan], params: JointParams) -> (BTreeMap<&'static str, u64>, V
             Some(&s.pose),
         );
         let p = fs.tracker.params;
+        for t in fs.tracker.confirmed() {
+            let l = to_laser(&s.pose, t.position());
+            if s.area.keeps(l) {
+                hyp.push(point(frame, t.id as i64, l));
+            }
+        }
         for &(id, w, ok) in &s.truth {
+            if ok {
+                gt.push(point(frame, id, to_laser(&s.pose, w)));
+            }
             let prev = last.insert(id, (s.time_s, w));
             let last: BTreeMap<i64, (f64, Point2<f64>)> = prev.into_iter().map(|v| (id, v)).collect();
             if !ok {
@@ -220,7 +272,28 @@ fn probe(scans: &[Scan], params: JointParams) -> (BTreeMap<&'static str, u64>, V
         .iter()
         .map(|(id, t0)| first_reported.get(id).map_or(f64::INFINITY, |t| t - t0))
         .collect();
-    (reasons, delays, scored)
+    let ev = evaluate(&gt, &hyp, MatchRule::Euclidean { max_m: 0.75 }).expect("valid observations");
+    if std::env::var("PROBE_FP").is_ok() {
+        let mut by: BTreeMap<i64, (i64, i64, u64)> = BTreeMap::new();
+        for e in ev.events.iter().filter(|e| e.kind == peopletrack::eval::mot::EventKind::FalsePositive) {
+            let v = by.entry(e.hyp_id.unwrap_or(-1)).or_insert((e.frame, e.frame, 0));
+            v.1 = e.frame;
+            v.2 += 1;
+        }
+        let mut v: Vec<_> = by.into_iter().collect();
+        v.sort_by_key(|x| std::cmp::Reverse(x.1.2));
+        for (id, (a, b, n)) in v.iter().take(6) {
+            println!("    FP track {id}: {n} false positives, scans {a}..{b}");
+        }
+    }
+    let c = ev.metrics.clear;
+    let mot = [
+        c.num_false_positives,
+        c.num_misses,
+        c.num_switches,
+        gt.len() as u64,
+    ];
+    (reasons, delays, scored, mot)
 }
 
 /// A real log of Leigh et al. with its `ground_truth.csv` beside it (laser-frame positions on
@@ -261,6 +334,7 @@ fn load_real(path: &str, scans_window: [usize; 2], wedge: [f64; 2]) -> Res<Vec<S
             ranges: f.scan.ranges.clone(),
             truth,
             pose,
+            area: Area::Real { in_window, wedge },
         });
     }
     Ok(out)
@@ -274,6 +348,13 @@ fn main() -> Res<()> {
     let rules = [
         ("leg_tracker", JointParams::leg_tracker()),
         ("default (quick)", JointParams::default()),
+        (
+            "quick + lone",
+            JointParams {
+                lone: Some(LONE),
+                ..JointParams::default()
+            },
+        ),
     ];
     for path in &paths {
         let scans = if path.contains("general_tracking_moving_1") {
@@ -282,7 +363,7 @@ fn main() -> Res<()> {
             load(path)?
         };
         for (name, params) in rules {
-            let (reasons, mut delays, scored) = probe(&scans, params);
+            let (reasons, mut delays, scored, [fp, fn_, sw, n]) = probe(&scans, params);
             delays.sort_by(f64::total_cmp);
             let missed: u64 = reasons.values().sum();
             let never = delays.iter().filter(|d| d.is_infinite()).count();
@@ -298,6 +379,8 @@ fn main() -> Res<()> {
             );
             let parts: Vec<String> = reasons.iter().map(|(k, v)| format!("{k} {v}")).collect();
             println!("  blocking: {}", parts.join(", "));
+            let mota = 1.0 - (fp + fn_ + sw) as f64 / n.max(1) as f64;
+            println!("  MOT: MOTA {mota:.3} FP {fp} FN {fn_} IDSW {sw} GT {n}");
         }
     }
     Ok(())

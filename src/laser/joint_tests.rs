@@ -3,7 +3,7 @@
 
 use nalgebra::{Point2, Vector2};
 
-use super::joint::{Cluster, JointParams, JointTracker};
+use super::joint::{Cluster, JointParams, JointTracker, LONE};
 use super::legs::{self, LegParams};
 use super::occupancy::GridParams;
 use super::people::FreeSpaceTracker;
@@ -60,6 +60,37 @@ fn the_quick_rule_reports_a_walker_earlier_and_never_a_still_pair() {
     let lt = first_person(JointParams::leg_tracker(), 1.0, 1.0, 0.0).expect("a person");
     assert!(quick < lt, "{quick} vs {lt}");
     assert!(quick >= 3, "{quick}: the midpoint moved 0.25 m at scan 3");
+}
+
+/// The lone-cluster option: one confident cluster walking at 1 m/s through free space becomes
+/// a person once its filtered path passed 0.5 m (in place: its id kept), never standing still,
+/// never at confidence 0.3 (< 0.5); without the option never; and a walking leg pair still
+/// makes exactly one person with it.
+#[test]
+fn a_lone_walking_cluster_becomes_a_person_only_with_the_lone_option() {
+    let lone = JointParams {
+        lone: Some(LONE),
+        ..JointParams::default()
+    };
+    let first_lone = |params: JointParams, speed: f64, confidence: f64| {
+        let mut t = JointTracker::new(params);
+        (0..60).find_map(|k| {
+            let y = speed * 0.1 * k as f64;
+            t.step(0.1 * k as f64, &[cluster(2.0, y, confidence, 0.0)]);
+            t.confirmed().next().map(|p| (k, p.id))
+        })
+    };
+    let (k, id) = first_lone(lone, 1.0, 1.0).expect("a person");
+    assert!((4..=10).contains(&k), "scan {k}");
+    assert_eq!(id, 1, "the object track became the person");
+    assert_eq!(first_lone(lone, 0.0, 1.0), None);
+    assert_eq!(first_lone(lone, 1.0, 0.3), None);
+    assert_eq!(first_lone(JointParams::default(), 1.0, 1.0), None);
+    let mut t = JointTracker::new(lone);
+    for k in 0..40 {
+        t.step(0.1 * k as f64, &pair(0.1 * k as f64, 1.0, 0.0));
+    }
+    assert_eq!(t.tracks().iter().filter(|tr| tr.person).count(), 1);
 }
 
 /// Outside free space (occupancy 0.1 ≥ 0.06) or with no confidence (below 0.1 the legs never
