@@ -30,7 +30,7 @@ use nalgebra::{Isometry3, Point2, Point3};
 use peopletrack::eval::mot::{Geometry, GroundPoint, MatchRule, Observation, evaluate};
 use peopletrack::frames::laser::{LaserOptions, scans};
 use peopletrack::frames::truth;
-use peopletrack::laser::joint::{JointParams, LONE};
+use peopletrack::laser::joint::{JointParams, LONE, LoneConfirm};
 use peopletrack::laser::legs::{self, LegParams};
 use peopletrack::laser::occupancy::GridParams;
 use peopletrack::laser::people::FreeSpaceTracker;
@@ -123,7 +123,13 @@ const REASONS: [&str; 7] = [
     "other",
 ];
 
-fn describe(t: f64, id: i64, w: Point2<f64>, objects: &[&peopletrack::laser::joint::Track], why: &str) {
+fn describe(
+    t: f64,
+    id: i64,
+    w: Point2<f64>,
+    objects: &[&peopletrack::laser::joint::Track],
+    why: &str,
+) {
     let f: Vec<String> = objects
         .iter()
         .map(|o| {
@@ -195,7 +201,8 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
                 gt.push(point(frame, id, to_laser(&s.pose, w)));
             }
             let prev = last.insert(id, (s.time_s, w));
-            let last: BTreeMap<i64, (f64, Point2<f64>)> = prev.into_iter().map(|v| (id, v)).collect();
+            let last: BTreeMap<i64, (f64, Point2<f64>)> =
+                prev.into_iter().map(|v| (id, v)).collect();
             if !ok {
                 continue;
             }
@@ -232,10 +239,7 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
                         .map_or(f64::NAN, |(t0, w0): &(f64, Point2<f64>)| {
                             (w - w0).norm() / (s.time_s - t0)
                         });
-                    let f: Vec<String> = objects
-                        .iter()
-                        .map(|t| format!("{:.3}", t.free))
-                        .collect();
+                    let f: Vec<String> = objects.iter().map(|t| format!("{:.3}", t.free)).collect();
                     let here = fs.grid.occupancy_around(w);
                     println!(
                         "    t {:.1} person {id} speed {speed:.2} m/s, grid at person {here:.3}, track free {}",
@@ -275,15 +279,44 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
     let ev = evaluate(&gt, &hyp, MatchRule::Euclidean { max_m: 0.75 }).expect("valid observations");
     if std::env::var("PROBE_FP").is_ok() {
         let mut by: BTreeMap<i64, (i64, i64, u64)> = BTreeMap::new();
-        for e in ev.events.iter().filter(|e| e.kind == peopletrack::eval::mot::EventKind::FalsePositive) {
-            let v = by.entry(e.hyp_id.unwrap_or(-1)).or_insert((e.frame, e.frame, 0));
+        for e in ev
+            .events
+            .iter()
+            .filter(|e| e.kind == peopletrack::eval::mot::EventKind::FalsePositive)
+        {
+            let v = by
+                .entry(e.hyp_id.unwrap_or(-1))
+                .or_insert((e.frame, e.frame, 0));
             v.1 = e.frame;
             v.2 += 1;
         }
         let mut v: Vec<_> = by.into_iter().collect();
         v.sort_by_key(|x| std::cmp::Reverse(x.1.2));
         for (id, (a, b, n)) in v.iter().take(6) {
-            println!("    FP track {id}: {n} false positives, scans {a}..{b}");
+            // nearest ground truth to the track over its false-positive scans
+            let mut near = Vec::new();
+            for h in hyp
+                .iter()
+                .filter(|h| h.id == *id && h.frame >= *a && h.frame <= *b)
+            {
+                let Geometry::Point(hp) = &h.geometry else {
+                    continue;
+                };
+                let d = gt
+                    .iter()
+                    .filter(|g| g.frame == h.frame)
+                    .filter_map(|g| match &g.geometry {
+                        Geometry::Point(gp) => Some((gp.x_m - hp.x_m).hypot(gp.y_m - hp.y_m)),
+                        _ => None,
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                near.push(d);
+            }
+            near.sort_by(f64::total_cmp);
+            let med = near.get(near.len() / 2).copied().unwrap_or(f64::NAN);
+            println!(
+                "    FP track {id}: {n} false positives, scans {a}..{b}, median distance to nearest person {med:.2} m"
+            );
         }
     }
     let c = ev.metrics.clear;
@@ -301,7 +334,8 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
 /// file scores `general_tracking_moving_1`. Diagnosis only: nothing is chosen from it.
 fn load_real(path: &str, scans_window: [usize; 2], wedge: [f64; 2]) -> Res<Vec<Scan>> {
     let log = SessionLog::open(path)?;
-    let csv = std::fs::read_to_string(std::path::Path::new(path).with_file_name("ground_truth.csv"))?;
+    let csv =
+        std::fs::read_to_string(std::path::Path::new(path).with_file_name("ground_truth.csv"))?;
     let mut gt: BTreeMap<usize, Vec<(i64, Point2<f64>)>> = BTreeMap::new();
     for l in csv.lines().filter(|l| !l.starts_with('#')) {
         let f: Vec<&str> = l.split(',').collect();
@@ -323,7 +357,11 @@ fn load_real(path: &str, scans_window: [usize; 2], wedge: [f64; 2]) -> Res<Vec<S
                     .map(|(id, l)| {
                         let a = l.y.atan2(l.x).to_degrees();
                         let w = pose.transform_point(&Point3::new(l.x, l.y, 0.0));
-                        (*id, Point2::new(w.x, w.y), in_window && a >= wedge[0] && a <= wedge[1])
+                        (
+                            *id,
+                            Point2::new(w.x, w.y),
+                            in_window && a >= wedge[0] && a <= wedge[1],
+                        )
                     })
                     .collect()
             })
@@ -352,6 +390,16 @@ fn main() -> Res<()> {
             "quick + lone",
             JointParams {
                 lone: Some(LONE),
+                ..JointParams::default()
+            },
+        ),
+        (
+            "quick + lone, 0.5 m displaced",
+            JointParams {
+                lone: Some(LoneConfirm {
+                    min_displacement_m: 0.5,
+                    ..LONE
+                }),
                 ..JointParams::default()
             },
         ),

@@ -46,12 +46,13 @@
 //! where a displacement does not.
 //!
 //! **Lone-cluster confirmation** (ours, [`LoneConfirm`]; off by default): an object track
-//! matched on this scan, in no candidate pair, with running confidence ≥ `min_confidence`,
-//! in free space, that travelled `min_travel_m` since it started becomes a person in place —
-//! for people whose legs show as one cluster (on `general_tracking_moving_1` the largest
-//! reason people go unreported). On the synthetic quick sessions it added more false
-//! positives than it removed misses (pooled MOTA 0.752 → 0.675, `examples/laser_confirm_probe`),
-//! so it stays off.
+//! matched on this scan, in no candidate pair and farther than `max_pair_m` from every
+//! person, with running confidence ≥ `min_confidence`, in free space, that travelled
+//! `min_travel_m` since it started (and moved `min_displacement_m` from where it started)
+//! becomes a person in place — for people whose legs show as one cluster (on
+//! `general_tracking_moving_1` the largest reason people go unreported). On the synthetic
+//! quick sessions it added more false positives than it removed misses (pooled MOTA 0.752 →
+//! 0.704, `examples/laser_confirm_probe`), so it stays off.
 //!
 //! Reported people ([`JointTracker::confirmed`]): every person track, or only those matched on
 //! this scan when `publish_occluded` is false (leg_tracker's option). Ids are 1, 2, … in
@@ -90,6 +91,8 @@ pub struct QuickConfirm {
 pub struct LoneConfirm {
     /// Least running confidence of the lone track.
     pub min_confidence: f64,
+    /// Least straight-line displacement (m) of the track from where it started; 0: none.
+    pub min_displacement_m: f64,
 }
 
 /// Parameters (module doc).
@@ -169,6 +172,7 @@ pub const QUICK: QuickConfirm = QuickConfirm {
 /// leg_tracker's (module doc).
 pub const LONE: LoneConfirm = LoneConfirm {
     min_confidence: 0.5,
+    min_displacement_m: 0.0,
 };
 
 impl Default for JointParams {
@@ -197,6 +201,8 @@ pub struct Track {
     pub free: f64,
     /// Distance travelled (m).
     pub travelled_m: f64,
+    /// Where the track started (fixed frame, m).
+    pub origin: Point2<f64>,
     /// Matched on the last scan.
     pub seen: bool,
 }
@@ -394,6 +400,7 @@ impl JointTracker {
             confidence: c.confidence,
             free: c.occupancy,
             travelled_m: 0.0,
+            origin: at,
             seen: true,
         });
         self.next_id += 1;
@@ -494,8 +501,9 @@ impl JointTracker {
     }
 
     /// Our lone-cluster confirmation (module doc): an object track matched on this scan, in no
-    /// candidate pair, confident and in free space, that travelled `min_travel_m` since it
-    /// started becomes a person in place (its id and filter kept).
+    /// candidate pair and farther than `max_pair_m` from every person (else it is that
+    /// person's other leg), confident and in free space, that travelled `min_travel_m` since
+    /// it started becomes a person in place (its id and filter kept).
     fn confirm_lone(&mut self) {
         let p = self.params;
         let Some(lone) = p.lone else {
@@ -503,16 +511,28 @@ impl JointTracker {
         };
         let paired: std::collections::BTreeSet<u64> =
             self.pairs.keys().flat_map(|&(a, b)| [a, b]).collect();
+        let mut people: Vec<Point2<f64>> = self
+            .tracks
+            .iter()
+            .filter(|t| t.person)
+            .map(Track::position)
+            .collect();
         for t in &mut self.tracks {
+            let beside_a_person = people
+                .iter()
+                .any(|q| (t.position() - q).norm() <= p.max_pair_m);
             if !t.person
                 && t.seen
+                && !beside_a_person
                 && !paired.contains(&t.id)
                 && t.confidence >= lone.min_confidence
                 && t.free < p.free_threshold
                 && t.travelled_m > p.min_travel_m
+                && (t.position() - t.origin).norm() >= lone.min_displacement_m
             {
                 t.person = true;
                 t.free = 0.0;
+                people.push(t.position());
             }
         }
     }
