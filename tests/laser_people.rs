@@ -377,11 +377,31 @@ fn leg_tracker_annotations_score_the_same() {
     std::fs::create_dir_all(&data).expect("mkdir");
     write_log(&data.join("leigh_walkers.mcap"), true);
     let toml = dir.path().join("laser_people.toml");
-    std::fs::write(&toml, format!("{PIPELINE}{LEIGH_SEQUENCE}")).expect("write pipeline");
+    // scored as the paper's Following Outdoor benchmark too (paper_table3)
+    let following = "paper_benchmark = \"following_outdoor\"\n";
+    std::fs::write(&toml, format!("{PIPELINE}{LEIGH_SEQUENCE}{following}"))
+        .expect("write pipeline");
     let out = dir.path().join("out");
     let sessions = vec![format!("{}/*.mcap", data.display())];
     let summary = run_file(&toml, &options(&out, sessions)).expect("runs");
     assert!(summary.skipped.is_empty(), "{:?}", summary.skipped);
+    // under the paper's following protocol: counts of the annotated people only, no false
+    // positives or MOTA; the baseline holds the nearer walker, so half the objects
+    let t3 = csv_rows(&out.join("laser_people/tables/paper_table3.csv"));
+    let ours = |tracker: &str| {
+        t3.iter()
+            .find(|r| r["source"] == "this run: leigh_walkers" && r["tracker"] == tracker)
+            .unwrap_or_else(|| panic!("no {tracker} row in {t3:?}"))
+    };
+    let (legs, nearest) = (ours("legs"), ours("nearest"));
+    for (r, valid, misses, accuracy) in [(legs, "16", "0", "1.0"), (nearest, "8", "8", "0.5")] {
+        assert_eq!(r["benchmark"], "Following Outdoor");
+        assert_eq!((&*r["objects"], &*r["valid"]), ("16", valid), "{r:?}");
+        assert_eq!((&*r["id_switches"], &*r["misses"]), ("0", misses), "{r:?}");
+        assert_eq!((&*r["false_positives"], &*r["mota"]), ("", ""), "{r:?}");
+        assert_eq!(r["target_accuracy"], accuracy, "{r:?}");
+    }
+    assert_eq!(t3.iter().filter(|r| r["source"] == "paper").count(), 3);
     let rows = csv_rows(&out.join("laser_people/tables/results.csv"));
     let legs = row(&rows, "leigh_walkers", "legs");
     assert_eq!((&*legs["scored_scans"], &*legs["gt_count"]), ("8", "16"));
