@@ -377,7 +377,20 @@ pub(super) fn run(
             fp_causes::STATIC_EXTENT_M
         )),
     );
-    paper::products(p, &results, &mut out)?;
+    let counts: Vec<paper::Counts> = results
+        .iter()
+        .map(|r| paper::Counts {
+            sequence: r.sequence.clone(),
+            detector: r.detector.clone(),
+            objects: r.gt_count,
+            misses: r.misses,
+            id_switches: r.id_switches,
+            false_positives: r.false_positives,
+            mota: r.mota,
+            motp_m: r.motp_m,
+        })
+        .collect();
+    paper::products(p, &counts, &mut out)?;
     classifier::products(p, &mut out)?;
     Ok((out, data, results))
 }

@@ -22,47 +22,24 @@
 //! tracks, 645 objects); only the first is in `../shared/real` (36 s scored, 133 objects), so
 //! that comparison is of rates, not of the same scans.
 
-use serde::{Deserialize, Serialize};
-
-use super::aggregate::ResultRow;
-use super::params::Params;
+use super::params::{PaperBenchmark, Params};
 use crate::report::Table;
 use crate::report::rows::Rows;
 use crate::run::Products;
 use crate::table_row;
 
-/// The paper's benchmarks (Table II).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum PaperBenchmark {
-    /// General multi-person tracking, stationary robot (7 min 11 s, 45 tracks).
-    StationaryRobot,
-    /// General multi-person tracking, moving robot (5 min 1 s, 37 tracks).
-    MovingRobot,
-    /// Tracking for following, indoors (21 min 24 s, one person).
-    FollowingIndoor,
-    /// Tracking for following, outdoors (12 min, one person).
-    FollowingOutdoor,
-}
-
-impl PaperBenchmark {
-    /// Table III's name of the benchmark.
-    pub fn title(self) -> &'static str {
-        match self {
-            PaperBenchmark::StationaryRobot => "Stationary Robot",
-            PaperBenchmark::MovingRobot => "Moving Robot",
-            PaperBenchmark::FollowingIndoor => "Following Indoor",
-            PaperBenchmark::FollowingOutdoor => "Following Outdoor",
-        }
-    }
-
-    /// Whether only the followed person is annotated (false positives and MOTA undefined).
-    pub fn following(self) -> bool {
-        matches!(
-            self,
-            PaperBenchmark::FollowingIndoor | PaperBenchmark::FollowingOutdoor
-        )
-    }
+/// One of our scored sequence × method rows, as the aggregation hands it over (None: a
+/// skipped row).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Counts {
+    pub sequence: String,
+    pub detector: String,
+    pub objects: Option<i64>,
+    pub misses: Option<i64>,
+    pub id_switches: Option<i64>,
+    pub false_positives: Option<i64>,
+    pub mota: Option<f64>,
+    pub motp_m: Option<f64>,
 }
 
 /// One printed row of Table III.
@@ -202,8 +179,8 @@ pub fn printed(r: &PrintedRow) -> Table3Row {
 }
 
 /// One of our scored rows under benchmark `b`'s protocol; None for a skipped row.
-pub fn ours(b: PaperBenchmark, r: &ResultRow) -> Option<Table3Row> {
-    let (objects, misses, switches) = (r.gt_count?, r.misses?, r.id_switches?);
+pub fn ours(b: PaperBenchmark, r: &Counts) -> Option<Table3Row> {
+    let (objects, misses, switches) = (r.objects?, r.misses?, r.id_switches?);
     let following = b.following();
     Some(Table3Row {
         benchmark: b.title().into(),
@@ -222,11 +199,7 @@ pub fn ours(b: PaperBenchmark, r: &ResultRow) -> Option<Table3Row> {
 
 /// The paper's rows of every benchmark a listed sequence belongs to, each followed by this
 /// run's rows for that sequence; one summary line per method of a following sequence.
-pub(super) fn products(
-    p: &Params,
-    results: &[ResultRow],
-    out: &mut Products,
-) -> anyhow::Result<()> {
+pub(super) fn products(p: &Params, results: &[Counts], out: &mut Products) -> anyhow::Result<()> {
     let mut rows = Vec::new();
     for seq in &p.sequences {
         let Some(b) = seq.paper_benchmark else {
@@ -325,18 +298,13 @@ mod tests {
         assert_eq!(objects(PaperBenchmark::MovingRobot), [645; 3]);
     }
 
-    fn result(sequence: &str) -> ResultRow {
-        ResultRow {
-            dataset: sequence.into(),
+    fn result(sequence: &str) -> Counts {
+        Counts {
             sequence: sequence.into(),
             detector: "legs".into(),
-            status: "ok".into(),
-            scored_scans: Some(10),
-            gt_count: Some(100),
+            objects: Some(100),
             mota: Some(0.5),
             motp_m: Some(0.07),
-            idf1: Some(0.6),
-            hota: Some(0.5),
             false_positives: Some(40),
             misses: Some(8),
             id_switches: Some(2),
@@ -356,8 +324,8 @@ mod tests {
         let joint = printed(&TABLE_III[11]);
         assert_eq!(joint.tracker, "Joint Leg");
         assert!((joint.target_accuracy.expect("following") - (1.0 - 125.0 / 6198.0)).abs() < 1e-12);
-        let skipped = ResultRow {
-            gt_count: None,
+        let skipped = Counts {
+            objects: None,
             ..result("s")
         };
         assert!(ours(PaperBenchmark::MovingRobot, &skipped).is_none());

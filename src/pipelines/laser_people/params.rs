@@ -6,10 +6,43 @@ use serde::{Deserialize, Serialize};
 
 use super::learned::LearnedParams;
 use super::methods::Method;
-use super::paper::PaperBenchmark;
 use crate::groundtruth::PEOPLE_TOPIC;
 use crate::laser::training::FeatureSet;
 use crate::run::config::Invalid;
+
+/// The benchmarks of Leigh et al. (ICRA 2015, Table II), for `paper_table3` ([`super::paper`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PaperBenchmark {
+    /// General multi-person tracking, stationary robot (7 min 11 s, 45 tracks).
+    StationaryRobot,
+    /// General multi-person tracking, moving robot (5 min 1 s, 37 tracks).
+    MovingRobot,
+    /// Tracking for following, indoors (21 min 24 s, one person).
+    FollowingIndoor,
+    /// Tracking for following, outdoors (12 min, one person).
+    FollowingOutdoor,
+}
+
+impl PaperBenchmark {
+    /// Table III's name of the benchmark.
+    pub fn title(self) -> &'static str {
+        match self {
+            PaperBenchmark::StationaryRobot => "Stationary Robot",
+            PaperBenchmark::MovingRobot => "Moving Robot",
+            PaperBenchmark::FollowingIndoor => "Following Indoor",
+            PaperBenchmark::FollowingOutdoor => "Following Outdoor",
+        }
+    }
+
+    /// Whether only the followed person is annotated (false positives and MOTA undefined).
+    pub fn following(self) -> bool {
+        matches!(
+            self,
+            PaperBenchmark::FollowingIndoor | PaperBenchmark::FollowingOutdoor
+        )
+    }
+}
 
 /// How one sequence (a session, by name) is read and scored.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
