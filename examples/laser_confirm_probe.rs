@@ -26,19 +26,18 @@
 
 use std::collections::BTreeMap;
 
+#[path = "common/synthetic_laser.rs"]
+mod synthetic_laser;
+
 use nalgebra::{Isometry3, Point2, Point3};
-use peopletrack::eval::mot::{Geometry, GroundPoint, MatchRule, Observation, evaluate};
+use peopletrack::eval::mot::{Geometry, MatchRule, evaluate};
 use peopletrack::frames::laser::{LaserOptions, scans};
-use peopletrack::frames::truth;
 use peopletrack::laser::joint::{JointParams, LONE, LoneConfirm};
-use peopletrack::laser::legs::{self, LegParams};
 use peopletrack::laser::occupancy::GridParams;
 use peopletrack::laser::people::FreeSpaceTracker;
-use peopletrack::laser::points::{self, ScanGeometry};
-use peopletrack::laser::segment::{self, SegmentOptions};
+use peopletrack::laser::points::ScanGeometry;
 use peopletrack::log::SessionLog;
-
-type Res<T> = Result<T, Box<dyn std::error::Error>>;
+use synthetic_laser::{Res, leg_model, point, scored, to_laser};
 
 struct Scan {
     time_s: f64,
@@ -61,7 +60,7 @@ enum Area {
 impl Area {
     fn keeps(self, l: Point2<f64>) -> bool {
         match self {
-            Area::Synthetic => l.x >= 0.0 && l.coords.norm() <= 5.0,
+            Area::Synthetic => scored(&l),
             Area::Real { in_window, wedge } => {
                 let a = l.y.atan2(l.x).to_degrees();
                 in_window && a >= wedge[0] && a <= wedge[1]
@@ -70,47 +69,22 @@ impl Area {
     }
 }
 
-fn to_laser(pose: &Isometry3<f64>, p: Point2<f64>) -> Point2<f64> {
-    let q = pose.inverse_transform_point(&Point3::new(p.x, p.y, 0.0));
-    Point2::new(q.x, q.y)
-}
-
 fn load(path: &str) -> Res<Vec<Scan>> {
-    let log = SessionLog::open(path)?;
-    let (gt, _) = truth::people(&log, "/ground_truth/people")?;
-    let options = LaserOptions {
-        fixed_frame: Some("map".into()),
-        ..LaserOptions::default()
-    };
-    let mut out = Vec::new();
-    let mut t0 = None;
-    for f in scans(&log, "/scan", &options)? {
-        let f = f?;
-        let Some(pose) = f.pose else { continue };
-        let t0 = *t0.get_or_insert(f.stamp);
-        let truth = gt
-            .nearest(f.stamp, 50_000_000)
-            .map(|fr| {
-                fr.people
-                    .iter()
-                    .map(|p| {
-                        let w = Point2::new(p.x, p.y);
-                        let l = to_laser(&pose, w);
-                        (i64::from(p.id), w, l.x >= 0.0 && l.coords.norm() <= 5.0)
-                    })
-                    .collect()
-            })
-            .unwrap_or_default();
-        out.push(Scan {
-            time_s: f.stamp.signed_sub(t0) as f64 * 1e-9,
-            geometry: ScanGeometry::of(&f.scan),
-            ranges: f.scan.ranges.clone(),
-            truth,
-            pose,
+    Ok(synthetic_laser::load(path)?
+        .into_iter()
+        .map(|s| Scan {
+            truth: s
+                .truth
+                .iter()
+                .map(|&(id, w)| (id, w, scored(&to_laser(&s.pose, w))))
+                .collect(),
+            time_s: s.time_s,
+            ranges: s.ranges,
+            geometry: s.geometry,
+            pose: s.pose,
             area: Area::Synthetic,
-        });
-    }
-    Ok(out)
+        })
+        .collect())
 }
 
 const REASONS: [&str; 7] = [
@@ -151,15 +125,6 @@ fn describe(
 /// ([FP, FN, IDSW, GT]) of one rule on one log.
 type Probe = (BTreeMap<&'static str, u64>, Vec<f64>, u64, [u64; 4]);
 
-fn point(frame: i64, id: i64, p: Point2<f64>) -> Observation {
-    Observation {
-        frame,
-        id,
-        geometry: Geometry::Point(GroundPoint { x_m: p.x, y_m: p.y }),
-        confidence: 1.0,
-    }
-}
-
 /// Blocking-reason counts and per-person delays (s) of one rule on one log.
 fn probe(scans: &[Scan], params: JointParams) -> Probe {
     let mut fs = FreeSpaceTracker::new(params, GridParams::default());
@@ -171,15 +136,7 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
     let (mut gt, mut hyp) = (Vec::new(), Vec::new());
     for (frame, s) in scans.iter().enumerate() {
         let frame = frame as i64;
-        let pts = points::project(&s.ranges, &s.geometry, Some(&s.pose));
-        let segs = segment::segment(&pts, &SegmentOptions::default());
-        let d = legs::detect(
-            &pts,
-            &segs,
-            s.ranges.len(),
-            Some(&s.pose),
-            &LegParams::default(),
-        );
+        let (pts, d) = leg_model(&s.ranges, &s.geometry, Some(&s.pose));
         fs.step(
             s.time_s,
             &d,

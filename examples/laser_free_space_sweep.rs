@@ -19,10 +19,11 @@
 //! only). Part 2 tracks on the true pose, on the default matcher's odometry, and in the laser
 //! frame (every pose the identity).
 
-use nalgebra::{Isometry3, Point2, Point3};
-use peopletrack::eval::mot::{Geometry, GroundPoint, MatchRule, Observation, evaluate};
-use peopletrack::frames::laser::{LaserOptions, scans};
-use peopletrack::frames::truth;
+#[path = "common/synthetic_laser.rs"]
+mod synthetic_laser;
+
+use nalgebra::{Isometry3, Point2};
+use peopletrack::eval::mot::{MatchRule, evaluate};
 use peopletrack::laser::joint::{JointParams, QuickConfirm};
 use peopletrack::laser::legs::{self, LegParams};
 use peopletrack::laser::occupancy::GridParams;
@@ -30,9 +31,7 @@ use peopletrack::laser::people::FreeSpaceTracker;
 use peopletrack::laser::points::{self, ScanGeometry};
 use peopletrack::laser::scan_match::{MatchParams, Pose2, ScanOdometry, static_mask};
 use peopletrack::laser::segment::{self, SegmentOptions};
-use peopletrack::log::SessionLog;
-
-type Res<T> = Result<T, Box<dyn std::error::Error>>;
+use synthetic_laser::{Res, leg_model, point, scored, to_laser};
 
 struct Scan {
     time_s: f64,
@@ -40,15 +39,6 @@ struct Scan {
     geometry: ScanGeometry,
     truth: Vec<(i64, Point2<f64>)>,
     pose: Isometry3<f64>,
-}
-
-fn to_laser(pose: &Isometry3<f64>, p: Point2<f64>) -> Point2<f64> {
-    let q = pose.inverse_transform_point(&Point3::new(p.x, p.y, 0.0));
-    Point2::new(q.x, q.y)
-}
-
-fn scored(p: &Point2<f64>) -> bool {
-    p.x >= 0.0 && p.coords.norm() <= 5.0
 }
 
 /// `--outdoor-sensor`: the synthetic scans cut to what `person_following_outdoor_1`'s scanner
@@ -75,41 +65,26 @@ fn cut(ranges: &mut [f32], g: &ScanGeometry, c: Cut) {
 }
 
 fn load(path: &str, sensor: Option<Cut>) -> Res<Vec<Scan>> {
-    let log = SessionLog::open(path)?;
-    let (gt, _) = truth::people(&log, "/ground_truth/people")?;
-    let options = LaserOptions {
-        fixed_frame: Some("map".into()),
-        ..LaserOptions::default()
-    };
-    let mut out = Vec::new();
-    let mut t0 = None;
-    for f in scans(&log, "/scan", &options)? {
-        let f = f?;
-        let Some(pose) = f.pose else { continue };
-        let t0 = *t0.get_or_insert(f.stamp);
-        let truth = gt
-            .nearest(f.stamp, 50_000_000)
-            .map(|fr| {
-                fr.people
+    Ok(synthetic_laser::load(path)?
+        .into_iter()
+        .map(|s| {
+            let mut ranges = s.ranges;
+            if let Some(c) = sensor {
+                cut(&mut ranges, &s.geometry, c);
+            }
+            Scan {
+                time_s: s.time_s,
+                truth: s
+                    .truth
                     .iter()
-                    .map(|p| (i64::from(p.id), to_laser(&pose, Point2::new(p.x, p.y))))
-                    .collect()
-            })
-            .unwrap_or_default();
-        let geometry = ScanGeometry::of(&f.scan);
-        let mut ranges = f.scan.ranges.clone();
-        if let Some(c) = sensor {
-            cut(&mut ranges, &geometry, c);
-        }
-        out.push(Scan {
-            time_s: f.stamp.signed_sub(t0) as f64 * 1e-9,
-            geometry,
-            ranges,
-            truth,
-            pose,
-        });
-    }
-    Ok(out)
+                    .map(|&(id, p)| (id, to_laser(&s.pose, p)))
+                    .collect(),
+                ranges,
+                geometry: s.geometry,
+                pose: s.pose,
+            }
+        })
+        .collect())
 }
 
 /// The scan-matched poses of a session, with the mean 1 s relative pose error and failures.
@@ -156,29 +131,12 @@ enum Source {
     Laser,
 }
 
-fn point(frame: i64, id: i64, p: Point2<f64>) -> Observation {
-    Observation {
-        frame,
-        id,
-        geometry: Geometry::Point(GroundPoint { x_m: p.x, y_m: p.y }),
-        confidence: 1.0,
-    }
-}
-
 /// (FP, FN, IDSW, GT count, Σ match distance, matches) of one session on poses `poses`.
 fn track(scans: &[Scan], poses: &[Isometry3<f64>], params: JointParams) -> Res<[f64; 6]> {
     let mut fs = FreeSpaceTracker::new(params, GridParams::default());
     let (mut gt, mut hyp) = (Vec::new(), Vec::new());
     for (i, (s, pose)) in scans.iter().zip(poses).enumerate() {
-        let pts = points::project(&s.ranges, &s.geometry, Some(pose));
-        let segs = segment::segment(&pts, &SegmentOptions::default());
-        let d = legs::detect(
-            &pts,
-            &segs,
-            s.ranges.len(),
-            Some(pose),
-            &LegParams::default(),
-        );
+        let (pts, d) = leg_model(&s.ranges, &s.geometry, Some(pose));
         fs.step(s.time_s, &d, &[], &pts, &s.ranges, &s.geometry, Some(pose));
         let frame = i as i64;
         for (id, p) in &s.truth {

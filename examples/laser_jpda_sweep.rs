@@ -8,17 +8,13 @@
 //! Usage: `cargo run --example laser_jpda_sweep [-- LOG.mcap …]` (default: the synthetic logs).
 //! Never run it on the real logs to choose a value: those are scored once, at the defaults.
 
-use nalgebra::{Point2, Point3};
-use peopletrack::eval::mot::{Geometry, GroundPoint, MatchRule, Observation, evaluate};
-use peopletrack::frames::laser::{LaserOptions, scans};
-use peopletrack::frames::truth;
-use peopletrack::laser::legs::{self, LegParams};
-use peopletrack::laser::points::{self, ScanGeometry};
-use peopletrack::laser::segment::{self, SegmentOptions};
-use peopletrack::laser::tracker::{Association, JpdaParams, PeopleTracker, TrackerParams};
-use peopletrack::log::SessionLog;
+#[path = "common/synthetic_laser.rs"]
+mod synthetic_laser;
 
-type Res<T> = Result<T, Box<dyn std::error::Error>>;
+use nalgebra::Point2;
+use peopletrack::eval::mot::{MatchRule, evaluate};
+use peopletrack::laser::tracker::{Association, JpdaParams, PeopleTracker, TrackerParams};
+use synthetic_laser::{Res, leg_model, point, scored, to_laser};
 
 /// Per scan: time, laser-frame ground truth, fixed-frame people and single legs, the pose.
 struct Scan {
@@ -29,66 +25,25 @@ struct Scan {
     pose: nalgebra::Isometry3<f64>,
 }
 
-fn to_laser(pose: &nalgebra::Isometry3<f64>, p: Point2<f64>) -> Point2<f64> {
-    let q = pose.inverse_transform_point(&Point3::new(p.x, p.y, 0.0));
-    Point2::new(q.x, q.y)
-}
-
-fn scored(p: &Point2<f64>) -> bool {
-    p.x >= 0.0 && p.coords.norm() <= 5.0
-}
-
+/// The scans of a synthetic log with the seed 002 leg model's detections.
 fn load(path: &str) -> Res<Vec<Scan>> {
-    let log = SessionLog::open(path)?;
-    let (gt, _) = truth::people(&log, "/ground_truth/people")?;
-    let options = LaserOptions {
-        fixed_frame: Some("map".into()),
-        ..LaserOptions::default()
-    };
-    let mut out = Vec::new();
-    let mut t0 = None;
-    for f in scans(&log, "/scan", &options)? {
-        let f = f?;
-        let Some(pose) = f.pose else { continue };
-        let s = &f.scan;
-        let g = ScanGeometry::of(s);
-        let pts = points::project(&s.ranges, &g, Some(&pose));
-        let segs = segment::segment(&pts, &SegmentOptions::default());
-        let d = legs::detect(
-            &pts,
-            &segs,
-            s.ranges.len(),
-            Some(&pose),
-            &LegParams::default(),
-        );
-        let t0 = *t0.get_or_insert(f.stamp);
-        let truth = gt
-            .nearest(f.stamp, 50_000_000)
-            .map(|fr| {
-                fr.people
+    Ok(synthetic_laser::load(path)?
+        .into_iter()
+        .map(|s| {
+            let (_, d) = leg_model(&s.ranges, &s.geometry, Some(&s.pose));
+            Scan {
+                time_s: s.time_s,
+                truth: s
+                    .truth
                     .iter()
-                    .map(|p| (i64::from(p.id), to_laser(&pose, Point2::new(p.x, p.y))))
-                    .collect()
-            })
-            .unwrap_or_default();
-        out.push(Scan {
-            time_s: f.stamp.signed_sub(t0) as f64 * 1e-9,
-            truth,
-            people: d.people.iter().map(|p| p.fixed).collect(),
-            single: d.single_legs.iter().map(|&i| d.legs[i].fixed).collect(),
-            pose,
-        });
-    }
-    Ok(out)
-}
-
-fn point(frame: i64, id: i64, p: Point2<f64>) -> Observation {
-    Observation {
-        frame,
-        id,
-        geometry: Geometry::Point(GroundPoint { x_m: p.x, y_m: p.y }),
-        confidence: 1.0,
-    }
+                    .map(|&(id, p)| (id, to_laser(&s.pose, p)))
+                    .collect(),
+                people: d.people.iter().map(|p| p.fixed).collect(),
+                single: d.single_legs.iter().map(|&i| d.legs[i].fixed).collect(),
+                pose: s.pose,
+            }
+        })
+        .collect())
 }
 
 /// (FP, FN, IDSW, GT count, IDTP, IDFP + IDFN) of one session under `params`.
