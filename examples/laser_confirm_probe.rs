@@ -14,7 +14,7 @@
 //! - `other`: all of that holds and the pair is still not a person (pairing distance, both
 //!   legs matched on the scan, the quick rule's conditions).
 //!
-//! Prints the counts per rule (leg_tracker's alone, the default quick rule, and the quick
+//! Prints the counts per rule (with the median range of each reason's positions) (leg_tracker's alone, the default quick rule, and the quick
 //! rule with the lone-cluster option), the delay from a person's first scored scan to their
 //! first reported one, and CLEAR MOT at 0.75 m over the scored positions (the pipeline's
 //! protocol: synthetic in front of the laser within 5 m; `general_tracking_moving_1` read with
@@ -123,7 +123,13 @@ fn describe(
 
 /// Blocking-reason counts, per-person delays (s), scored positions and CLEAR MOT at 0.75 m
 /// ([FP, FN, IDSW, GT]) of one rule on one log.
-type Probe = (BTreeMap<&'static str, u64>, Vec<f64>, u64, [u64; 4]);
+type Probe = (
+    BTreeMap<&'static str, u64>,
+    Vec<f64>,
+    u64,
+    [u64; 4],
+    BTreeMap<&'static str, Vec<f64>>,
+);
 
 /// Blocking-reason counts and per-person delays (s) of one rule on one log.
 fn probe(scans: &[Scan], params: JointParams) -> Probe {
@@ -133,6 +139,7 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
     let mut first_reported: BTreeMap<i64, f64> = BTreeMap::new();
     let mut scored = 0;
     let mut last: BTreeMap<i64, (f64, Point2<f64>)> = BTreeMap::new();
+    let mut ranges: BTreeMap<&'static str, Vec<f64>> = BTreeMap::new();
     let (mut gt, mut hyp) = (Vec::new(), Vec::new());
     for (frame, s) in scans.iter().enumerate() {
         let frame = frame as i64;
@@ -227,6 +234,10 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
                 "other"
             };
             *reasons.entry(reason).or_default() += 1;
+            ranges
+                .entry(reason)
+                .or_default()
+                .push(to_laser(&s.pose, w).coords.norm());
         }
     }
     let delays = first_seen
@@ -283,7 +294,7 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
         c.num_switches,
         gt.len() as u64,
     ];
-    (reasons, delays, scored, mot)
+    (reasons, delays, scored, mot, ranges)
 }
 
 /// A real log of Leigh et al. with its `ground_truth.csv` beside it (laser-frame positions on
@@ -368,7 +379,7 @@ fn main() -> Res<()> {
             load(path)?
         };
         for (name, params) in rules {
-            let (reasons, mut delays, scored, [fp, fn_, sw, n]) = probe(&scans, params);
+            let (reasons, mut delays, scored, [fp, fn_, sw, n], mut ranges) = probe(&scans, params);
             delays.sort_by(f64::total_cmp);
             let missed: u64 = reasons.values().sum();
             let never = delays.iter().filter(|d| d.is_infinite()).count();
@@ -382,7 +393,20 @@ fn main() -> Res<()> {
                 delays.len(),
                 finite.join(" ")
             );
-            let parts: Vec<String> = reasons.iter().map(|(k, v)| format!("{k} {v}")).collect();
+            let parts: Vec<String> = reasons
+                .iter()
+                .map(|(k, v)| {
+                    let r = ranges.get_mut(k).map_or(f64::NAN, |r| {
+                        r.sort_by(f64::total_cmp);
+                        r[r.len() / 2]
+                    });
+                    if *v > 0 {
+                        format!("{k} {v} (median range {r:.1} m)")
+                    } else {
+                        format!("{k} 0")
+                    }
+                })
+                .collect();
             println!("  blocking: {}", parts.join(", "));
             let mota = 1.0 - (fp + fn_ + sw) as f64 / n.max(1) as f64;
             println!("  MOT: MOTA {mota:.3} FP {fp} FN {fn_} IDSW {sw} GT {n}");
