@@ -8,8 +8,9 @@
 //! - `no_track`: legs found, but no object track near them;
 //! - `low_confidence`: tracks, but none with running confidence ≥ 0.1 (they cannot pair);
 //! - `not_free`: confident tracks, none in free space (running free value ≥ 0.06);
-//! - `one_leg`: fewer than two confident tracks near them (the legs are one cluster, or one
-//!   is hidden or not found);
+//! - `one_leg`: one confident track near them and no other (the legs are one cluster, or one
+//!   is hidden); `one_leg_other_rejected`: one confident track and another track near them
+//!   below the confidence pairing needs (the leg model rejected the second leg);
 //! - `short_travel`: two confident tracks, one free, but none travelled 0.5 m yet;
 //! - `other`: all of that holds and the pair is still not a person (pairing distance, both
 //!   legs matched on the scan, the quick rule's conditions).
@@ -87,12 +88,13 @@ fn load(path: &str) -> Res<Vec<Scan>> {
         .collect())
 }
 
-const REASONS: [&str; 7] = [
+const REASONS: [&str; 8] = [
     "no_leg",
     "no_track",
     "low_confidence",
     "not_free",
     "one_leg",
+    "one_leg_other_rejected",
     "short_travel",
     "other",
 ];
@@ -221,7 +223,11 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
                 if std::env::var("PROBE_VERBOSE").is_ok() {
                     describe(s.time_s, id, w, &objects, "one_leg");
                 }
-                "one_leg"
+                if objects.len() >= 2 {
+                    "one_leg_other_rejected"
+                } else {
+                    "one_leg"
+                }
             } else if !objects.iter().any(|t| t.travelled_m > p.min_travel_m) {
                 if std::env::var("PROBE_VERBOSE").is_ok() {
                     describe(s.time_s, id, w, &objects, "short_travel");
