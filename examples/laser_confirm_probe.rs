@@ -15,7 +15,10 @@
 //! - `other`: all of that holds and the pair is still not a person (pairing distance, both
 //!   legs matched on the scan, the quick rule's conditions).
 //!
-//! Prints the counts per rule (with the median range of each reason's positions) (leg_tracker's alone, the default quick rule, and the quick
+//! Prints, per log, the share of scored positions with 0, 1, 2 or 3+ segments of the scan
+//! within 0.4 m of the person (what the scene shows, whatever the tracker does: a realism
+//! check of synthetic legs against the real log), and the counts per rule (with the median
+//! range of each reason's positions) (leg_tracker's alone, the default quick rule, and the quick
 //! rule with the lone-cluster option), the delay from a person's first scored scan to their
 //! first reported one, and CLEAR MOT at 0.75 m over the scored positions (the pipeline's
 //! protocol: synthetic in front of the laser within 5 m; `general_tracking_moving_1` read with
@@ -37,8 +40,18 @@ use peopletrack::laser::joint::{JointParams, LONE, LoneConfirm};
 use peopletrack::laser::occupancy::GridParams;
 use peopletrack::laser::people::FreeSpaceTracker;
 use peopletrack::laser::points::ScanGeometry;
+use peopletrack::laser::segment::{self, SegmentOptions};
+use peopletrack::laser::training::centroid;
 use peopletrack::log::SessionLog;
 use synthetic_laser::{Res, leg_model, point, scored, to_laser};
+
+/// `println!` that stops quietly when stdout is closed (e.g. piped into `head`).
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
 
 struct Scan {
     time_s: f64,
@@ -120,7 +133,7 @@ fn describe(
             )
         })
         .collect();
-    println!("    {why} t {t:.1} person {id}: {}", f.join(" "));
+    say!("    {why} t {t:.1} person {id}: {}", f.join(" "));
 }
 
 /// Blocking-reason counts, per-person delays (s), scored positions and CLEAR MOT at 0.75 m
@@ -131,6 +144,7 @@ type Probe = (
     u64,
     [u64; 4],
     BTreeMap<&'static str, Vec<f64>>,
+    [u64; 4],
 );
 
 /// Blocking-reason counts and per-person delays (s) of one rule on one log.
@@ -142,6 +156,9 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
     let mut scored = 0;
     let mut last: BTreeMap<i64, (f64, Point2<f64>)> = BTreeMap::new();
     let mut ranges: BTreeMap<&'static str, Vec<f64>> = BTreeMap::new();
+    // scored positions with 0, 1, 2, 3+ segments (any confidence) within 0.4 m: the scene's
+    // realism, whatever the tracker does
+    let mut clusters = [0u64; 4];
     let (mut gt, mut hyp) = (Vec::new(), Vec::new());
     for (frame, s) in scans.iter().enumerate() {
         let frame = frame as i64;
@@ -162,9 +179,16 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
                 hyp.push(point(frame, t.id as i64, l));
             }
         }
+        let centroids: Vec<Point2<f64>> = segment::segment(&pts, &SegmentOptions::default())
+            .iter()
+            .map(|sg| centroid(&pts, sg))
+            .collect();
         for &(id, w, ok) in &s.truth {
             if ok {
-                gt.push(point(frame, id, to_laser(&s.pose, w)));
+                let l = to_laser(&s.pose, w);
+                gt.push(point(frame, id, l));
+                let n = centroids.iter().filter(|c| (*c - l).norm() <= 0.4).count();
+                clusters[n.min(3)] += 1;
             }
             let prev = last.insert(id, (s.time_s, w));
             let last: BTreeMap<i64, (f64, Point2<f64>)> =
@@ -207,7 +231,7 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
                         });
                     let f: Vec<String> = objects.iter().map(|t| format!("{:.3}", t.free)).collect();
                     let here = fs.grid.occupancy_around(w);
-                    println!(
+                    say!(
                         "    t {:.1} person {id} speed {speed:.2} m/s, grid at person {here:.3}, track free {}",
                         s.time_s,
                         f.join(" ")
@@ -288,7 +312,7 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
             }
             near.sort_by(f64::total_cmp);
             let med = near.get(near.len() / 2).copied().unwrap_or(f64::NAN);
-            println!(
+            say!(
                 "    FP track {id}: {n} false positives, scans {a}..{b}, median distance to nearest person {med:.2} m"
             );
         }
@@ -300,7 +324,7 @@ fn probe(scans: &[Scan], params: JointParams) -> Probe {
         c.num_switches,
         gt.len() as u64,
     ];
-    (reasons, delays, scored, mot, ranges)
+    (reasons, delays, scored, mot, ranges, clusters)
 }
 
 /// A real log of Leigh et al. with its `ground_truth.csv` beside it (laser-frame positions on
@@ -385,7 +409,8 @@ fn main() -> Res<()> {
             load(path)?
         };
         for (name, params) in rules {
-            let (reasons, mut delays, scored, [fp, fn_, sw, n], mut ranges) = probe(&scans, params);
+            let (reasons, mut delays, scored, [fp, fn_, sw, n], mut ranges, clusters) =
+                probe(&scans, params);
             delays.sort_by(f64::total_cmp);
             let missed: u64 = reasons.values().sum();
             let never = delays.iter().filter(|d| d.is_infinite()).count();
@@ -394,7 +419,7 @@ fn main() -> Res<()> {
                 .filter(|d| d.is_finite())
                 .map(|d| format!("{d:.1}"))
                 .collect();
-            println!(
+            say!(
                 "{path} [{name}]: {scored} scored positions, {missed} without a reported person; {} people, {never} never reported; delays (s) {}",
                 delays.len(),
                 finite.join(" ")
@@ -413,9 +438,17 @@ fn main() -> Res<()> {
                     }
                 })
                 .collect();
-            println!("  blocking: {}", parts.join(", "));
+            say!("  blocking: {}", parts.join(", "));
             let mota = 1.0 - (fp + fn_ + sw) as f64 / n.max(1) as f64;
-            println!("  MOT: MOTA {mota:.3} FP {fp} FN {fn_} IDSW {sw} GT {n}");
+            say!("  MOT: MOTA {mota:.3} FP {fp} FN {fn_} IDSW {sw} GT {n}");
+            let share = |k: usize| clusters[k] as f64 / scored.max(1) as f64;
+            say!(
+                "  segments within 0.4 m of a scored person: 0 {:.2}, 1 {:.2}, 2 {:.2}, 3+ {:.2}",
+                share(0),
+                share(1),
+                share(2),
+                share(3)
+            );
         }
     }
     Ok(())
