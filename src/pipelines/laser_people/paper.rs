@@ -218,15 +218,10 @@ pub(super) fn products(p: &Params, results: &[Counts], out: &mut Products) -> an
                 b.title()
             ));
         }
-        let joint = TABLE_III
+        let paper = TABLE_III
             .iter()
-            .find(|r| r.benchmark == b && r.tracker == "Joint Leg");
-        for (r, j) in mine
-            .iter()
-            .filter(|_| b.following())
-            .zip(std::iter::repeat(joint))
-        {
-            let paper = j.map_or_else(String::new, |j| {
+            .find(|r| r.benchmark == b && r.tracker == "Joint Leg")
+            .map_or_else(String::new, |j| {
                 format!(
                     " (paper's Joint Leg tracker on {}: {} / {} / {})",
                     b.title(),
@@ -235,6 +230,7 @@ pub(super) fn products(p: &Params, results: &[Counts], out: &mut Products) -> an
                     j.misses
                 )
             });
+        for r in mine.iter().filter(|_| b.following()) {
             out.summary.push(format!(
                 "{} {} under the paper's following protocol: valid {}, ID switches {}, misses {} of {}{paper}.",
                 seq.name, r.tracker, r.valid, r.id_switches, r.misses, r.objects
