@@ -1,6 +1,7 @@
 //! The aggregation: every session's cached tables read back, then the products in order —
 //! Table I and the `rst` events ([`super::table1`]), the replayed methods and their t-tests
-//! ([`super::compare`]), the colour separation ([`super::colour`]), method 1's loss rate
+//! ([`super::compare`]), the colour separation and clutter density ([`super::colour`]), the
+//! first losses ([`super::losses`]), method 1's loss rate
 //! ([`super::method1`]), the real log ([`super::real`]) and the figures ([`super::figures`]).
 
 use super::params::Params;
@@ -17,6 +18,11 @@ pub fn products(ctx: &Aggregate, p: &Params) -> anyhow::Result<Products> {
     out.tables.push(super::colour::table(&synthetic, p)?);
     out.tables
         .push(super::colour::scatter_table(&synthetic, p)?);
+    out.tables
+        .push(super::colour::clutter_table(&synthetic, p)?);
+    out.tables.push(super::losses::table(&synthetic, p)?);
+    out.tables
+        .push(super::losses::occlusion_table(&synthetic, p)?);
     let m1: Vec<Method1Row> = synthetic
         .iter()
         .flat_map(|d| d.method1.iter().cloned())

@@ -11,14 +11,16 @@
 //! tracker output ([`closed_loop`]); a real laser log goes through [`real`] instead.
 //! Aggregation ([`aggregate`]): Table I, "followed" and the rst events ([`table1`]), the
 //! methods, their re-acquisitions and the Holm-corrected t-tests ([`compare`]), the colour
-//! descriptor's separation of target and clutter ([`colour`]), method 1's loss rate, the real
-//! log, the figures ([`figures`]).
+//! descriptor's separation of target and clutter and the clutter density ([`colour`]), how
+//! each method first loses the person ([`losses`]), method 1's loss rate, the real log, the
+//! figures ([`figures`]).
 
 mod aggregate;
 mod closed_loop;
 mod colour;
 mod compare;
 mod figures;
+mod losses;
 mod method1;
 mod params;
 mod pose;

@@ -302,6 +302,7 @@ fn step_all(
         if name == params::PAPER
             && let (Some(m), Some(frame)) = (map_from_fixed.as_ref(), people)
         {
+            let target = frame.people.iter().find(|q| q.id == ctx.p.target_id);
             colour.extend(out.blob_corr.iter().map(|(c, corr)| {
                 let q = m * Point3::new(c[0], c[1], 0.0);
                 let (kind, offset) = blob_kind(frame, (q.x, q.y), ctx.p);
@@ -311,6 +312,8 @@ fn step_all(
                     corr: *corr,
                     dx: offset.map(|o| o[0]),
                     dy: offset.map(|o| o[1]),
+                    tdx: target.map(|t| q.x - t.x),
+                    tdy: target.map(|t| q.y - t.y),
                 }
             }));
         }

@@ -145,7 +145,8 @@ table_row! {
     /// One blob of one scan as the paper's configuration saw it: its normalised correlation
     /// with the template and what the ground truth says it is (`target`, `person` — another
     /// person — or `static`: nobody within `lock_m`), and for a person's blob its centre minus
-    /// that person's true position (map frame, m): `colour`.
+    /// that person's true position (map frame, m); `tdx`, `tdy`: its centre minus the
+    /// target's true position (when the target is in the scene): `colour`.
     #[derive(Debug, Clone, PartialEq)]
     pub struct ColourRow {
         pub scan_idx: i64,
@@ -153,6 +154,8 @@ table_row! {
         pub corr: f64,
         pub dx: Option<f64>,
         pub dy: Option<f64>,
+        pub tdx: Option<f64>,
+        pub tdy: Option<f64>,
     }
 }
 
