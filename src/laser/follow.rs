@@ -18,6 +18,16 @@
 //! the robot stops and turns towards the last prediction ([`StepOutput::look_at`]) — and keeps
 //! looking. Without colour (or before any template) it takes the nearest blob, as at the start.
 //!
+//! **Colour watchdog** (our addition, off in the paper's configuration:
+//! `FollowParams::colour_watch_s`). The paper's only `rst` is the covariance test, and a track
+//! fed by the wrong blob never trips it: an occluder or a companion in the gate while the
+//! target's own blob is missing takes nearly all the association weight whatever its colour,
+//! because the no-target hypothesis weighs only λ|2πS|^{1/2}(1 − P_D P_G) ≈ 0.002 against
+//! P_D·lr ≈ 0.05–0.2 for a blob of another colour. With the watchdog, when every update that
+//! moved the track (β₀ < ½) for `colour_watch_s` seconds came mostly from a blob whose
+//! normalised correlation with the template is below `reacquire_corr`, the track is dropped as
+//! by `rst` and re-acquired by colour.
+//!
 //! **Blobs** (our reading of "connected components that might have originated from people"):
 //! jump-distance segments ([`crate::laser::segment`]) merged while the gap between the end of
 //! one and the start of the next is under `merge_gap_m` (a person's two legs), kept when at
@@ -78,6 +88,11 @@ pub struct FollowParams {
     pub reinit_max_m: f64,
     /// Cylinder resolution (columns over 2π, rows over the mirror's elevations).
     pub cylinder: [usize; 2],
+    /// Our addition, off in the paper's configuration: a colour watchdog. When, for this many
+    /// seconds, every update that moved the track (β₀ < ½) took it mostly from a blob whose
+    /// normalised correlation with the template is below `reacquire_corr`, the track is
+    /// dropped as by `rst` and re-acquired by colour (see the module doc).
+    pub colour_watch_s: Option<f64>,
 }
 
 impl Default for FollowParams {
@@ -105,6 +120,7 @@ impl Default for FollowParams {
             reinit_radius_m: 1.5,
             reinit_max_m: 10.0,
             cylinder: [720, 120],
+            colour_watch_s: None,
         }
     }
 }
@@ -142,6 +158,8 @@ pub struct FollowSpec {
     pub init_radius_m: f64,
     pub reinit_radius_m: f64,
     pub reinit_max_m: f64,
+    /// The colour watchdog (our addition; absent: off, the paper's tracker).
+    pub colour_watch_s: Option<f64>,
 }
 
 impl Default for FollowSpec {
@@ -176,6 +194,7 @@ impl Default for FollowSpec {
             init_radius_m: p.init_radius_m,
             reinit_radius_m: p.reinit_radius_m,
             reinit_max_m: p.reinit_max_m,
+            colour_watch_s: p.colour_watch_s,
         }
     }
 }
@@ -222,6 +241,7 @@ impl FollowSpec {
             reinit_radius_m: self.reinit_radius_m,
             reinit_max_m: self.reinit_max_m,
             cylinder: FollowParams::default().cylinder,
+            colour_watch_s: self.colour_watch_s,
         }
     }
 
@@ -261,6 +281,14 @@ impl FollowSpec {
             out.push((
                 "clutter_density".into(),
                 format!("{} must be finite and >= 0", self.clutter_density),
+            ));
+        }
+        if let Some(w) = self.colour_watch_s
+            && !(w.is_finite() && w > 0.0)
+        {
+            out.push((
+                "colour_watch_s".into(),
+                format!("{w} must be finite and > 0"),
             ));
         }
         if !(self.reacquire_corr.is_finite() && self.reacquire_corr <= 1.0) {
@@ -372,8 +400,11 @@ pub struct Estimate {
 pub struct StepOutput {
     /// `None` while the target is lost (the robot stops).
     pub estimate: Option<Estimate>,
-    /// The `rst` rule fired on this scan.
+    /// The `rst` rule fired on this scan (the covariance test, or the colour watchdog when
+    /// `colour_reset` is set too).
     pub reset: bool,
+    /// The colour watchdog (`FollowParams::colour_watch_s`) dropped the track on this scan.
+    pub colour_reset: bool,
     /// The track was (re-)initialised on this scan.
     pub initialised: bool,
     pub blobs: usize,
@@ -398,6 +429,7 @@ impl StepOutput {
         StepOutput {
             estimate: None,
             reset: false,
+            colour_reset: false,
             initialised: false,
             blobs,
             gated: 0,
@@ -422,6 +454,8 @@ pub struct FollowTracker {
     lost_at: Option<f64>,
     started: bool,
     map: Option<CylinderMap>,
+    /// Since when the track has been fed only by blobs of the wrong colour (the watchdog).
+    off_colour_since: Option<f64>,
 }
 
 /// One scan's blobs with what colour says about them.
@@ -444,6 +478,7 @@ impl FollowTracker {
             lost_at: None,
             started: false,
             map: None,
+            off_colour_since: None,
         }
     }
 
@@ -542,8 +577,11 @@ impl FollowTracker {
             out.chosen_corr = corr.get(j).copied().flatten();
             self.learn_template(hists.get(j).and_then(Option::as_ref));
         }
-        if needs_reset {
+        let off_colour = self.watch_colour(obs.t, a.beta0, out.chosen_corr);
+        if needs_reset || off_colour {
             out.reset = true;
+            out.colour_reset = off_colour && !needs_reset;
+            self.off_colour_since = None;
             self.anchor = position;
             self.lost_at = Some(obs.t);
             self.filter = None;
@@ -552,6 +590,27 @@ impl FollowTracker {
         }
         out.estimate = Some(estimate);
         Ok(out)
+    }
+
+    /// The colour watchdog (our addition, `colour_watch_s`): true when the track has been
+    /// moved only by blobs below the re-acquisition floor for the configured time. An update
+    /// that moved the track (β₀ < ½) from a blob of known correlation starts or clears the
+    /// clock; coasting and blobs without a histogram leave it as it is.
+    fn watch_colour(&mut self, t: f64, beta0: f64, chosen_corr: Option<f64>) -> bool {
+        let Some(limit) = self.params.colour_watch_s else {
+            return false;
+        };
+        match chosen_corr {
+            Some(c) if beta0 < 0.5 && c < self.params.reacquire_corr => {
+                let since = *self.off_colour_since.get_or_insert(t);
+                t - since >= limit
+            }
+            Some(_) if beta0 < 0.5 => {
+                self.off_colour_since = None;
+                false
+            }
+            _ => false,
+        }
     }
 
     /// The template from the accepted blob's histogram: taken when there is none yet (no
@@ -598,6 +657,7 @@ impl FollowTracker {
         self.filter = Some(filter);
         self.started = true;
         self.lost_at = None;
+        self.off_colour_since = None;
     }
 }
 

@@ -217,3 +217,49 @@ fn a_lost_follower_reports_where_it_lost_the_target() {
     let at = reset_look.expect("rst fired");
     assert!((at[0] - 2.97).abs() < 0.1 && at[1].abs() < 0.1, "{at:?}");
 }
+
+/// The colour watchdog's clock (our addition): with 1 s, updates taken from off-colour blobs
+/// (normalised corr below the 0.5 floor, β₀ < ½) drop the track on the update 1 s after the
+/// first; one update from a blob of the template's colour restarts the clock; coasting
+/// (β₀ ≥ ½) and blobs without a histogram neither advance nor clear it; off, it never fires.
+#[test]
+fn colour_watchdog_fires_after_its_time_off_colour() {
+    let mut p = params(ModelKind::Ct);
+    p.colour_watch_s = Some(1.0);
+    let mut tr = FollowTracker::new(&p, [0.0, 0.0]);
+    // off colour from t = 0: fires at 1.0, not before
+    for k in 0..10 {
+        assert!(
+            !tr.watch_colour(0.1 * f64::from(k), 0.1, Some(0.2)),
+            "k = {k}"
+        );
+    }
+    // coasting and unknown colour at 0.95 leave the clock running
+    assert!(!tr.watch_colour(0.95, 0.9, Some(0.9)));
+    assert!(!tr.watch_colour(0.97, 0.1, None));
+    assert!(tr.watch_colour(1.0, 0.1, Some(0.2)));
+    // the template's colour clears it: the next off-colour run needs its own full second
+    let mut tr = FollowTracker::new(&p, [0.0, 0.0]);
+    assert!(!tr.watch_colour(0.0, 0.1, Some(0.0)));
+    assert!(!tr.watch_colour(0.5, 0.1, Some(0.8)));
+    assert!(!tr.watch_colour(0.6, 0.1, Some(0.0)));
+    assert!(!tr.watch_colour(1.5, 0.1, Some(0.49)));
+    assert!(tr.watch_colour(1.6, 0.1, Some(0.49)));
+    // off: never
+    let mut off = FollowTracker::new(&params(ModelKind::Ct), [0.0, 0.0]);
+    assert!((0..100).all(|k| !off.watch_colour(0.1 * f64::from(k), 0.0, Some(-0.5))));
+}
+
+#[test]
+fn a_non_positive_watchdog_time_is_named() {
+    let spec = FollowSpec {
+        colour_watch_s: Some(0.0),
+        ..FollowSpec::default()
+    };
+    let problems = spec.problems();
+    assert!(
+        problems.iter().any(|(k, _)| k == "colour_watch_s"),
+        "{problems:?}"
+    );
+    assert!(FollowSpec::default().problems().is_empty());
+}

@@ -314,6 +314,18 @@ pub fn ttests(data: &[&SessionData], p: &Params) -> Vec<TestRow> {
         ));
     }
     out.extend(literal_readings(data, p));
+    let w = params::WATCH;
+    if has(c) && has(w) {
+        let f = |r: &MethodRow| Some(r.on_target);
+        out.push(paired(
+            "colour watchdog (ours): off (the paper) vs on",
+            "run",
+            "share of scans within lock_m of the person",
+            (c, &per_run(c, &f)),
+            (w, &per_run(w, &f)),
+            lvl,
+        ));
+    }
     let up = params::UPDATED;
     if has(c) && has(up) {
         let q = "colour template: held vs updated";

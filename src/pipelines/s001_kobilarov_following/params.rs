@@ -47,6 +47,9 @@ pub struct Params {
     /// Weight of the newest histogram in the updated template (`ct_colour_updated`), per scan
     /// with an association.
     pub template_update: f64,
+    /// The colour watchdog's time for `ct_colour_watch` (s; our addition, chosen on the `dev`
+    /// profile).
+    pub colour_watch_s: f64,
     /// A person within this distance (m, beyond their radius) of the laser's line of sight to
     /// the target, and nearer than it, occludes it.
     pub occlusion_margin_m: f64,
@@ -95,6 +98,7 @@ impl Default for Params {
             methods: METHODS.iter().map(|m| (*m).to_string()).collect(),
             follower: FollowSpec::default(),
             template_update: 0.05,
+            colour_watch_s: 1.0,
             occlusion_margin_m: 0.1,
             lock_m: 0.5,
             after_occlusion_s: 2.0,
@@ -131,6 +135,9 @@ pub enum Method {
         /// ([`crate::track::pdaf::RESET_SIGMAS_LITERAL`]) instead of the multiplier derived
         /// from its reset timing (`follower.reset_sigmas`).
         literal_rst: bool,
+        /// The colour watchdog (our addition, `laser::follow::FollowParams::colour_watch_s`)
+        /// at `colour_watch_s`.
+        colour_watch: bool,
     },
     /// The laser issue's multi-person tracker (`laser::tracker`), its track nearest the
     /// target followed.
@@ -145,17 +152,20 @@ pub const UPDATED: &str = "ct_colour_updated";
 pub const PRINTED: &str = "ct_colour_printed";
 /// The same with `rst` when √λ_max(P_xy) > 5 σ_r, the paper's "usually 5" read literally.
 pub const RST5: &str = "ct_colour_rst5";
+/// Our addition: the paper's configuration with the colour watchdog (`colour_watch_s`).
+pub const WATCH: &str = "ct_colour_watch";
 pub const CV: &str = "cv_colour";
 pub const IMM: &str = "imm_colour";
 pub const NO_COLOUR: &str = "ct_no_colour";
 pub const NN: &str = "nn_ct";
 pub const LASER_TRACKER: &str = "laser_tracker";
 /// Every known method, in the default table order.
-pub const METHODS: [&str; 9] = [
+pub const METHODS: [&str; 10] = [
     PAPER,
     UPDATED,
     PRINTED,
     RST5,
+    WATCH,
     CV,
     IMM,
     NO_COLOUR,
@@ -175,6 +185,7 @@ pub fn method(name: &str) -> Option<Method> {
             update,
             printed: false,
             literal_rst: false,
+            colour_watch: false,
         })
     };
     match name {
@@ -187,6 +198,7 @@ pub fn method(name: &str) -> Option<Method> {
             update: false,
             printed: true,
             literal_rst: false,
+            colour_watch: false,
         }),
         RST5 => Some(Method::Follower {
             model: Ct,
@@ -195,6 +207,16 @@ pub fn method(name: &str) -> Option<Method> {
             update: false,
             printed: false,
             literal_rst: true,
+            colour_watch: false,
+        }),
+        WATCH => Some(Method::Follower {
+            model: Ct,
+            association: Pdaf,
+            colour: true,
+            update: false,
+            printed: false,
+            literal_rst: false,
+            colour_watch: true,
         }),
         CV => f(Cv, Pdaf, true, false),
         IMM => f(Imm, Pdaf, true, false),
@@ -215,6 +237,7 @@ impl Params {
 pub(super) fn validate(p: &Params) -> Vec<Invalid> {
     let mut out: Vec<Invalid> = Vec::new();
     for (k, v) in [
+        ("colour_watch_s", p.colour_watch_s),
         ("gt_tolerance_s", p.gt_tolerance_s),
         ("following_distance_m", p.following_distance_m),
         ("max_decel_mps2", p.max_decel_mps2),

@@ -17,7 +17,8 @@ use crate::progress::Progress;
 use crate::report::rows::Rows;
 use crate::run::{Session, SessionTables};
 
-/// The methods run on a real log: colour off, duplicates dropped, in table order.
+/// The methods run on a real log: colour off (so no colour watchdog either), duplicates
+/// dropped, in table order.
 pub fn methods(p: &Params) -> Vec<(String, Method)> {
     let mut out: Vec<(String, Method)> = Vec::new();
     for name in &p.methods {
@@ -37,6 +38,7 @@ pub fn methods(p: &Params) -> Vec<(String, Method)> {
                 update: false,
                 printed: false,
                 literal_rst,
+                colour_watch: false,
             },
             other => other,
         };

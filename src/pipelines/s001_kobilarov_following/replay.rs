@@ -37,6 +37,7 @@ impl Runner {
                 update,
                 printed,
                 literal_rst,
+                colour_watch,
             } => {
                 let mut fp = p.follower.params(model, association, colour);
                 if update {
@@ -47,6 +48,9 @@ impl Runner {
                 }
                 if literal_rst {
                     fp.filter.reset_sigmas = crate::track::pdaf::RESET_SIGMAS_LITERAL;
+                }
+                if colour_watch {
+                    fp.colour_watch_s = Some(p.colour_watch_s);
                 }
                 Runner::Follower(Box::new(FollowTracker::new(&fp, init)))
             }
