@@ -12,9 +12,9 @@ VENV_NB := target/py-venv-notebook
 PROFILE ?= quick
 
 help:
-	@echo "make eval      build (release), synthesize the default datasets if absent, run every pipeline, write out/ and out/REPORT.md"
+	@echo "make eval      build (release), synthesize the default datasets if absent or stale, run every pipeline, write out/ and out/REPORT.md"
 	@echo "make wildtrack import ../shared/real/wildtrack (if present) and run pipelines/real/s004_wildtrack.toml"
-	@echo "make datasets  synthesize every dataset in datasets/ whose logs are absent (PROFILE=quick|full)"
+	@echo "make datasets  synthesize every dataset in datasets/ whose logs are absent or stale (PROFILE=quick|full)"
 	@echo "make test      build and run every test (the CI command)"
 	@echo "make build-s3  release build with object storage (s3:// logs and --out; docs/cluster.md)"
 	@echo "make test-s3   a pipeline end to end against a local S3 server (Garage $(GARAGE_VERSION), installed once into $(TOOLS))"

@@ -387,3 +387,32 @@ fn an_interrupted_render_is_finished_with_the_same_bytes() {
         "the finished session differs from the whole render's"
     );
 }
+
+/// `synth --if-absent` keeps logs only when they are what the scenario renders now: logs
+/// rendered from this very file are current; after the file changes (one comment added) they
+/// are named stale; a log without our metadata is named too.
+#[test]
+fn logs_from_another_version_of_the_scenario_are_stale() {
+    use peopletrack::synth::stale_logs;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let logs = dir.path().join("logs");
+    synth_into(&logs, 2);
+    assert_eq!(
+        stale_logs(&scenario(), "quick", &logs).expect("checks"),
+        None
+    );
+    let edited = dir.path().join("tiny_scenario.toml");
+    let text = std::fs::read_to_string(scenario()).expect("fixture");
+    std::fs::write(&edited, format!("{text}\n# edited\n")).expect("write");
+    let why = stale_logs(&edited, "quick", &logs)
+        .expect("checks")
+        .expect("stale after an edit");
+    assert!(why.contains("another version"), "{why}");
+    // an empty folder has nothing stale
+    let empty = dir.path().join("empty");
+    std::fs::create_dir_all(&empty).expect("mkdir");
+    assert_eq!(
+        stale_logs(&scenario(), "quick", &empty).expect("checks"),
+        None
+    );
+}

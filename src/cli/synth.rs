@@ -20,7 +20,9 @@ pub struct Args {
     /// Folder for preview sheets (`<dir>/<name>/preview.png`).
     #[arg(long, default_value = "out/datasets")]
     pub preview: PathBuf,
-    /// Skip scenarios whose logs already exist.
+    /// Skip scenarios whose logs already exist and were rendered from this scenario file by
+    /// this generator (a log's `peopletrack.scenario` metadata records both); stale logs are
+    /// rendered again.
     #[arg(long)]
     pub if_absent: bool,
     /// Render only the sessions whose log is absent (to finish an interrupted render: each
@@ -40,13 +42,22 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
                 d.any(|e| e.is_ok_and(|e| e.path().extension().is_some_and(|x| x == "mcap")))
             })
         {
-            writeln!(
-                out,
-                "{}: logs exist in {}, skipped",
-                scenario.display(),
-                dir.display()
-            )?;
-            continue;
+            match synth::stale_logs(scenario, &a.profile, &dir)? {
+                None => {
+                    writeln!(
+                        out,
+                        "{}: logs exist in {}, skipped",
+                        scenario.display(),
+                        dir.display()
+                    )?;
+                    continue;
+                }
+                Some(why) => writeln!(
+                    out,
+                    "{}: stale ({why}), rendering again",
+                    scenario.display()
+                )?,
+            }
         }
         let started = std::time::Instant::now();
         let s = synth::synthesize_sessions(

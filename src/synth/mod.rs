@@ -77,6 +77,60 @@ pub fn synthesize(scenario_path: &Path, opts: &SynthOptions) -> anyhow::Result<S
 /// each session is rendered from its own index and seed, so completing an interrupted render
 /// gives the same logs as one uninterrupted render. [`SynthSummary::sessions`] lists the
 /// sessions written.
+/// Why the logs already in `dir` are not what this scenario renders now, if they are not:
+/// the first log (by name) whose `peopletrack.scenario` metadata names another scenario text
+/// or another generator version. Logs without that metadata, or that cannot be opened, are
+/// named too (a render will replace them). `None`: every log matches (or there is none).
+pub fn stale_logs(
+    scenario_path: &Path,
+    profile: &str,
+    dir: &Path,
+) -> anyhow::Result<Option<String>> {
+    let (_, text) = Scenario::load(scenario_path, profile)?;
+    let mut logs: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|d| {
+            d.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
+                .collect()
+        })
+        .unwrap_or_default();
+    logs.sort();
+    for log in logs {
+        let meta = match crate::log::SessionLog::open(&log) {
+            Ok(l) => l
+                .summary()
+                .metadata
+                .iter()
+                .find(|m| m.name == "peopletrack.scenario")
+                .map(|m| m.entries.clone()),
+            Err(e) => return Ok(Some(format!("{}: {e}", log.display()))),
+        };
+        let Some(meta) = meta else {
+            return Ok(Some(format!(
+                "{}: no peopletrack.scenario metadata",
+                log.display()
+            )));
+        };
+        if meta.get("scenario_toml") != Some(&text) {
+            return Ok(Some(format!(
+                "{} was rendered from another version of {}",
+                log.display(),
+                scenario_path.display()
+            )));
+        }
+        if meta.get("generator").map(String::as_str) != Some(session::GENERATOR_VERSION) {
+            return Ok(Some(format!(
+                "{} was rendered by {}, not {}",
+                log.display(),
+                meta.get("generator")
+                    .map_or("an unknown generator", String::as_str),
+                session::GENERATOR_VERSION
+            )));
+        }
+    }
+    Ok(None)
+}
+
 pub fn synthesize_sessions(
     scenario_path: &Path,
     opts: &SynthOptions,
