@@ -44,7 +44,8 @@ pub const SESSION_TABLES: &[TableDoc] = &[
     table(
         COLOUR,
         "One blob of one scan as the paper's configuration saw it: its normalised correlation \
-         with the template, what the ground truth says it is, and a person's blob's offset (m).",
+         with the template, what the ground truth says it is, a person's blob's offset from \
+         them and every blob's offset from the target (m).",
     ),
 ];
 
