@@ -194,11 +194,6 @@ pub const CLUTTER_RADII: [f64; 3] = [0.75, 1.5, 3.0];
 
 /// The rows, one per radius of [`CLUTTER_RADII`] (see [`clutter_table`]).
 pub fn clutter_rows(data: &[&SessionData]) -> Vec<ClutterRow> {
-    let scans = data
-        .iter()
-        .flat_map(|d| d.truth.iter())
-        .filter(|t| t.target_x.is_some() && !t.out_of_view)
-        .count() as i64;
     let in_view: std::collections::BTreeSet<(usize, i64)> = data
         .iter()
         .enumerate()
@@ -209,6 +204,7 @@ pub fn clutter_rows(data: &[&SessionData]) -> Vec<ClutterRow> {
                 .map(move |t| (k, t.scan_idx))
         })
         .collect();
+    let scans = in_view.len() as i64;
     CLUTTER_RADII
         .iter()
         .map(|&r| {
