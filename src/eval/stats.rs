@@ -94,6 +94,21 @@ impl fmt::Display for Summary {
     }
 }
 
+/// The median of the finite values (the mean of the middle two for an even count); `None`
+/// when there are none.
+pub fn median(mut v: Vec<f64>) -> Option<f64> {
+    v.retain(|x| x.is_finite());
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    (n > 0).then(|| {
+        if n % 2 == 1 {
+            v[n / 2]
+        } else {
+            0.5 * (v[n / 2 - 1] + v[n / 2])
+        }
+    })
+}
+
 /// Mean, sample standard deviation, standard error, min and max of `data` (n ≥ 2).
 pub fn describe(data: &[f64]) -> Result<Summary, StatsError> {
     check_len("describe", "data", data, 2)?;

@@ -539,3 +539,12 @@ fn results_serialise_for_tables() {
     let json = serde_json::to_value(describe(&A).expect("valid data")).expect("serialisable");
     assert_eq!(json["n"], 10);
 }
+
+#[test]
+fn median_of_odd_even_empty_and_non_finite() {
+    assert_eq!(median(vec![]), None);
+    assert_eq!(median(vec![3.0, 1.0, 2.0]), Some(2.0));
+    assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), Some(2.5));
+    assert_eq!(median(vec![f64::NAN, 5.0, f64::INFINITY]), Some(5.0));
+    assert_eq!(median(vec![f64::NAN]), None);
+}

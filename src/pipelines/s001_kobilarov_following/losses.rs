@@ -17,6 +17,7 @@
 
 use super::params::Params;
 use super::tables::{SessionData, TrackRow, TruthRow};
+use crate::eval::stats::median;
 use crate::report::rows::Rows;
 use crate::report::table::Table;
 use crate::table_row;
@@ -46,17 +47,6 @@ table_row! {
         pub out_of_view: f64,
         /// `rst` (any cause) in the window after the loss's start.
         pub rst: bool,
-    }
-}
-
-/// The median of the values (mean of the middle two for an even count).
-fn median(mut v: Vec<f64>) -> Option<f64> {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    match n {
-        0 => None,
-        _ if n % 2 == 1 => Some(v[n / 2]),
-        _ => Some(0.5 * (v[n / 2 - 1] + v[n / 2])),
     }
 }
 

@@ -103,13 +103,6 @@ fn a_short_excursion_is_no_loss() {
     assert_eq!(loss(&run(40, 4, None, true), &truth(40)), None);
 }
 
-#[test]
-fn medians() {
-    assert_eq!(median(vec![]), None);
-    assert_eq!(median(vec![3.0, 1.0, 2.0]), Some(2.0));
-    assert_eq!(median(vec![4.0, 1.0, 2.0, 3.0]), Some(2.5));
-}
-
 fn loop_row(t_s: f64, x: Option<f64>) -> super::super::tables::LoopRow {
     super::super::tables::LoopRow {
         t_s,
