@@ -60,6 +60,16 @@ const PAIR_GATE: f64 = 4.0;
 /// Step of the numerical Jacobian (m).
 const JACOBIAN_STEP_M: f64 = 1e-6;
 
+/// Steps 1–2's output (see [`CylinderTracker::ground_candidates`]).
+pub(super) struct GroundCandidates {
+    /// `(E_c, boxes, hypothesis)` of every valid multi-camera combination kept.
+    pub multi: Vec<(f64, Vec<usize>, Hypothesis)>,
+    /// Each box's one-camera fit (indexed like the prepared boxes).
+    pub single: Vec<Option<Hypothesis>>,
+    /// The boxes with a ground point and a foot point.
+    pub usable: Vec<usize>,
+}
+
 /// A pixel difference with its coordinates multiplied by a box's residual weights (exact when
 /// they are 1).
 fn weighted(d: Vector2<f64>, w: [f64; 2]) -> Vector2<f64> {
@@ -243,6 +253,19 @@ impl CylinderTracker {
         prepared: &[Prepared],
         stats: &mut StepStats,
     ) -> Vec<Hypothesis> {
+        let c = self.ground_candidates(prepared, stats);
+        let mut used = vec![false; prepared.len()];
+        let selected = select_disjoint(c.multi, &mut used);
+        self.with_leftovers(prepared, &c.single, &c.usable, &used, selected)
+    }
+
+    /// Steps 1–2 of the module doc: every valid multi-camera combination a seed grew (with
+    /// `occupancy`, every step of each growth too), and each box's one-camera fit.
+    pub(super) fn ground_candidates(
+        &self,
+        prepared: &[Prepared],
+        stats: &mut StepStats,
+    ) -> GroundCandidates {
         let usable: Vec<usize> = (0..prepared.len())
             .filter(|&i| prepared[i].ground.is_some() && prepared[i].foot_ideal.is_some())
             .collect();
@@ -308,8 +331,23 @@ impl CylinderTracker {
                 valid.push((h.e_c, c, h));
             }
         }
-        let mut used = vec![false; prepared.len()];
-        let mut selected = select_disjoint(valid, &mut used);
+        GroundCandidates {
+            multi: valid,
+            single,
+            usable,
+        }
+    }
+
+    /// Step 4 of the module doc: `selected` (the multi-camera people), then each usable box
+    /// not `used` as a one-camera person unless one of `selected` explains it.
+    pub(super) fn with_leftovers(
+        &self,
+        prepared: &[Prepared],
+        single: &[Option<Hypothesis>],
+        usable: &[usize],
+        used: &[bool],
+        mut selected: Vec<Hypothesis>,
+    ) -> Vec<Hypothesis> {
         let multi = selected.len();
         for &i in usable.iter().filter(|&&i| !used[i]) {
             if self.explained(&prepared[i], &selected[..multi]) {
