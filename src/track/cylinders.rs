@@ -64,7 +64,7 @@ mod occupancy;
 mod scalable;
 
 pub use head::{box_head_px, cylinder_radius};
-pub use occupancy::OccupancyParams;
+pub use occupancy::{OccupancyParams, OccupancySelect};
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CylinderError {

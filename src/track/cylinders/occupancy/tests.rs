@@ -289,3 +289,117 @@ fn bad_occupancy_parameters_are_named() {
         }
     }
 }
+
+/// The prepared boxes of `objs` keyed as `step_occupancy` keys them.
+fn keyed(prepared: &[Prepared]) -> BTreeMap<(usize, u32), &Prepared> {
+    prepared.iter().map(|o| ((o.camera, o.id), o)).collect()
+}
+
+#[test]
+fn a_box_s_chi2_is_zero_on_its_segment_and_grows_as_the_square_of_its_offset() {
+    // pinhole without distortion: ideal px = px; jitter 0, so the weights are 1 and
+    // χ² = Σ (offset / σ_w)², σ_w = p_Th / z₉₀, over foot and head (x, y)
+    let views = crowd_views();
+    let t = CylinderTracker::new(views.clone(), params()).expect("tracker");
+    let head = Point3::new(5.0, 7.0, 1.75);
+    let mut objs: Vec<Object2d> = objects(&views, &[(1, head.x, head.y, head.z)])
+        .into_iter()
+        .filter(|o| o.camera == 2)
+        .collect();
+    let prepared = t.prepare(&objs);
+    let chi2 = t.box_chi2(&prepared[0], &head).expect("projects");
+    assert!(chi2 < 1e-12, "{chi2}");
+    let shift = 6.0;
+    objs[0].head_px[0] += shift;
+    if let Some(f) = objs[0].foot_px.as_mut() {
+        f[0] += shift;
+    }
+    let prepared = t.prepare(&objs);
+    let chi2 = t.box_chi2(&prepared[0], &head).expect("projects");
+    let sigma = t.params.p_th_px / P90_SIGMAS;
+    let want = 2.0 * (shift / sigma).powi(2);
+    assert!((chi2 - want).abs() < 1e-6 * want, "{chi2} vs {want}");
+}
+
+#[test]
+fn a_confirmed_track_s_prediction_raises_a_candidate_s_prior_by_its_density() {
+    // ρ → ρ + N(x; prediction, P): on the prediction with P = s² I the log-odds gain
+    // ln(1 + 1 / (2π s² ρ)); a tentative track gives nothing
+    let views = crowd_views();
+    let t = CylinderTracker::new(views.clone(), params()).expect("tracker");
+    let objs = objects(&views, &[(1, 6.0, 5.0, 1.8)]);
+    let prepared = t.prepare(&objs);
+    let boxes = keyed(&prepared);
+    let people = t.detect_ground(&prepared, &mut StepStats::default());
+    assert_eq!(people.len(), 1);
+    let h = &people[0];
+    let s: f64 = 0.4;
+    let track = |id: Option<u32>, dx: f64| {
+        let mut kf = t.new_filter(h);
+        kf.x[0] += dx;
+        kf.p[(0, 0)] = s * s;
+        kf.p[(1, 1)] = s * s;
+        kf.p[(0, 1)] = 0.0;
+        kf.p[(1, 0)] = 0.0;
+        Track {
+            id,
+            kf,
+            support: h.support.clone(),
+            score: 10.0,
+            hits: 3,
+            misses: 0,
+            age: 2,
+            measured: None,
+        }
+    };
+    let alone = t.fit_log_odds(h, &boxes, &[]);
+    let rho = occupancy().people_per_m2;
+    let on = t.fit_log_odds(h, &boxes, &[track(Some(1), 0.0)]) - alone;
+    let want = (1.0 + 1.0 / (std::f64::consts::TAU * s * s * rho)).ln();
+    assert!((on - want).abs() < 1e-9, "{on} vs {want}");
+    assert_eq!(t.fit_log_odds(h, &boxes, &[track(None, 0.0)]), alone);
+    // one metre off: the density at d = 1 m of N(0, s² I)
+    let off = t.fit_log_odds(h, &boxes, &[track(Some(1), 1.0)]) - alone;
+    let want = (1.0 + (-0.5 / (s * s)).exp() / (std::f64::consts::TAU * s * s * rho)).ln();
+    assert!((off - want).abs() < 1e-9, "{off} vs {want}");
+}
+
+#[test]
+fn both_selections_find_a_noise_free_crowd_and_e_c_is_the_ground_association_s() {
+    let views = crowd_views();
+    let people = crowd(25);
+    let objs = objects(&views, &people);
+    for select in [OccupancySelect::Evidence, OccupancySelect::Ec] {
+        let p = CylinderParams {
+            occupancy: OccupancyParams {
+                select,
+                ..occupancy()
+            },
+            ..params()
+        };
+        let t = CylinderTracker::new(views.clone(), p).expect("tracker");
+        let prepared = t.prepare(&objs);
+        let found = match select {
+            OccupancySelect::Evidence => {
+                t.select_by_evidence(&prepared, &keyed(&prepared), &[], &mut StepStats::default())
+            }
+            OccupancySelect::Ec => t.detect_ground(&prepared, &mut StepStats::default()),
+        };
+        assert_eq!(found.len(), people.len(), "{select:?}");
+        for &(_, x, y, h) in &people {
+            assert!(
+                found
+                    .iter()
+                    .any(|f| (f.head_m - Point3::new(x, y, h)).norm() < 1e-6),
+                "{select:?}: nobody at ({x}, {y})"
+            );
+        }
+    }
+    let text = |s: &str| toml::from_str::<OccupancyParams>(&format!("select = \"{s}\""));
+    assert_eq!(text("e_c").expect("e_c").select, OccupancySelect::Ec);
+    assert_eq!(
+        text("evidence").expect("ev").select,
+        OccupancySelect::Evidence
+    );
+    assert!(text("ec").is_err());
+}
