@@ -4,7 +4,7 @@
 //! the face width and its width within a factor 2; frontal = yaw ≤ 15°, faces ≥ 24 px wide).
 //!
 //! Usage: `cargo run --release --example face_sweep -- LOG.mcap... [NAME:key=value,...]...`
-//! with keys `thresh`, `min_face`, `pyramid`, `step`; the system's default settings are always
+//! with keys `thresh`, `min_face`, `pyramid`, `step`, `upscale`; the system's default settings are always
 //! the first row.
 
 use peopletrack::frames::{camera, truth};
@@ -28,6 +28,7 @@ fn variant(spec: &str) -> Result<(String, FaceParams), String> {
             "min_face" => f.min_face_px = x as u32,
             "pyramid" => f.pyramid_scale = x as f32,
             "step" => f.step_px = x as u32,
+            "upscale" => f.upscale = x as u32,
             _ => return Err(format!("unknown key {k}")),
         }
     }
