@@ -5,7 +5,7 @@
 //! share within 5°, pooled over the logs given.
 //!
 //! Usage: `cargo run --release --example doa_sweep -- LOG.mcap... [NAME:key=value,...]...`
-//! with keys `band_lo`, `band_hi`, `frame`, `hop`, `loud_share`, `phat_beta`; the system's
+//! with keys `band_lo`, `band_hi`, `frame`, `hop`, `loud_share`, `phat_beta`, `onset`; the system's
 //! default settings are always the first row. `DUMP=NAME` prints that variant's every block.
 
 use std::collections::BTreeMap;
@@ -33,6 +33,7 @@ fn variant(spec: &str, base: GccParams) -> Result<(String, GccParams), String> {
             "hop" => g.hop = x as usize,
             "loud_share" => g.loud_share = x,
             "phat_beta" => g.phat_beta = x,
+            "onset" => g.onset = x,
             _ => return Err(format!("unknown key {k}")),
         }
     }

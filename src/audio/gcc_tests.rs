@@ -56,7 +56,8 @@ fn pure_fractional_delays_give_the_angle_within_a_tenth_of_a_degree() {
         let got = doa::cone_angle(d.tau_s, BIRON_SPACING_M).to_degrees();
         assert!((got - deg).abs() < 0.1, "{deg}°: got {got}°");
         assert!(d.peak > 0.9, "{deg}°: peak {}", d.peak);
-        assert_eq!(d.frames, 14, "every frame of the block");
+        // 28 frames at a 256-sample hop; the first only sets the onset weights' powers
+        assert_eq!(d.frames, 27, "every frame of the block");
     }
 }
 
@@ -94,7 +95,7 @@ fn every_phat_exponent_finds_a_pure_delay_of_coloured_noise_with_peak_one() {
                 "beta {beta}: peak {}",
                 d.peak
             );
-            assert_eq!(d.frames, if share == 1.0 { 14 } else { 7 });
+            assert_eq!(d.frames, if share == 1.0 { 27 } else { 13 });
         }
     }
 }
@@ -188,7 +189,58 @@ fn bad_blocks_and_settings_are_errors() {
             phat_beta: 1.5,
             ..GccParams::default()
         },
+        GccParams {
+            onset: -1.0,
+            ..GccParams::default()
+        },
+        GccParams {
+            onset: f64::NAN,
+            ..GccParams::default()
+        },
     ] {
         assert!(GccPhat::new(bad).is_err(), "{bad:?}");
+    }
+}
+
+#[test]
+fn the_onset_weight_is_the_clamped_share_of_the_rise() {
+    assert_eq!(onset_weight(4.0, 1.0, 1.0), 0.75);
+    assert_eq!(onset_weight(4.0, 1.0, 2.0), 0.5);
+    assert_eq!(onset_weight(1.0, 2.0, 1.0), 0.0, "a decaying bin");
+    assert_eq!(onset_weight(0.0, 0.0, 1.0), 0.0, "a silent bin");
+    assert_eq!(onset_weight(1.0, 1e9, 0.0), 1.0, "rho 0: no weighting");
+}
+
+/// A louder steady source at one lag and a quieter one in bursts ("syllables") at another:
+/// the plain sum follows the steady source, the onset weighting the bursts — as the direct
+/// sound of a new syllable against the reverberant tail of the earlier ones.
+#[test]
+fn onset_weighting_follows_the_bursts_not_the_louder_steady_source() {
+    let n = 16_384;
+    let (steady_delay, burst_delay) = (-4.0, 6.0);
+    let (s0, s1) = delayed_noise(n, steady_delay, 31);
+    let (b0, b1) = delayed_noise(n, burst_delay, 32);
+    // bursts of 256 samples every 1024 (mean power 9 / 4 = 2.25 against the steady source's
+    // 1.6² = 2.56), gated after the delay so both microphones switch together; with rarer
+    // bursts (every 2048 samples and more) the steady source wins either way: the weight of
+    // a stationary bin is 1 − P_{t−1}/P_t > 0 half the time
+    let gate = |i: usize| if i % 1024 < 256 { 1.0f32 } else { 0.0 };
+    let mix = |s: &[f32], b: &[f32]| -> Vec<f32> {
+        (0..n).map(|i| 1.6 * s[i] + 3.0 * gate(i) * b[i]).collect()
+    };
+    let (x0, x1) = (mix(&s0, &b0), mix(&s1, &b1));
+    let max = 1e-3;
+    for (onset, want) in [(0.0, steady_delay), (1.0, burst_delay)] {
+        let p = GccParams {
+            onset,
+            ..GccParams::default()
+        };
+        let mut g = GccPhat::new(p).expect("gcc");
+        let d = g.delay(block(&x0), block(&x1), max).expect("delay");
+        assert!(
+            (d.tau_s * FS - want).abs() < 0.5,
+            "onset {onset}: {} samples, want {want}",
+            d.tau_s * FS
+        );
     }
 }
