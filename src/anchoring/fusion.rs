@@ -16,9 +16,13 @@
 //!   torso component when it settles within [`FusionParams::torso_gate_rad`] with a
 //!   Bhattacharyya coefficient of at least [`FusionParams::torso_min_rho`], within
 //!   [`FusionParams::torso_hold_s`] of the legs' or face's last percept.
-//! - **Voice**: the sound's cone angle is turned into each anchor's front azimuth with its own
-//!   elevation (mouth height from the person's height, range from the microphones) and lands
-//!   on the nearest within [`FusionParams::voice_gate_rad`].
+//! - **Voice**: the sound lands on the anchor in front of the microphones whose own cone
+//!   (from its bearing and its elevation: mouth height from the person's height, range from
+//!   the microphones) is nearest to the sound's, compared in the delay's units sin θ = c·τ/d
+//!   within sin([`FusionParams::voice_gate_rad`]) ([`VoiceGate::Delay`], since the eighth
+//!   session); rounds 1–4 turned the cone into each anchor's front azimuth and gated the
+//!   bearing difference ([`VoiceGate::Azimuth`]), a gate that narrows in delay towards the
+//!   microphone axis, where one sample of delay spans the most degrees.
 //!
 //! An anchor is dropped when every component is lost.
 
@@ -33,6 +37,18 @@ use crate::vision::faces::Face;
 
 /// Head centre below the top of the head (m): half an adult head's height.
 pub const HEAD_HALF_HEIGHT_M: f64 = 0.12;
+
+/// Where a sound is compared with an anchor's direction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VoiceGate {
+    /// In the delay's units, sin θ = c·τ/d: the gate is `sin(voice_gate_rad)` wide
+    /// everywhere, as the delay's error is (a priori: 10° at broadside, wider in degrees
+    /// towards the microphone axis, where the DOA errs most in degrees).
+    Delay,
+    /// In front azimuth, `voice_gate_rad` wide (rounds 1–4).
+    Azimuth,
+}
 
 /// Gates, timeouts and defaults (our choices: the seed gives none).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -50,6 +66,8 @@ pub struct FusionParams {
     pub face_gate_rad: f64,
     pub torso_gate_rad: f64,
     pub voice_gate_rad: f64,
+    /// Where the voice gate is applied ([`VoiceGate`]).
+    pub voice_gate_space: VoiceGate,
     /// A face's width-derived distance must be within this factor of the anchor's.
     pub face_range_ratio: f64,
     /// A new leg track is adopted by an anchor without a live track this close (m): about a
@@ -74,6 +92,7 @@ impl Default for FusionParams {
             face_gate_rad: 6.0 * deg,
             torso_gate_rad: 8.0 * deg,
             voice_gate_rad: 10.0 * deg,
+            voice_gate_space: VoiceGate::Delay,
             face_range_ratio: 1.6,
             adopt_m: 0.8,
             default_height_m: 1.70,
@@ -303,6 +322,13 @@ impl Fusion {
             .filter_map(|(k, a)| {
                 let r = (a.position[0] - mics[0]).hypot(a.position[1] - mics[1]);
                 let el = doa::elevation(a.mouth_z(), mics[2], r);
+                if self.params.voice_gate_space == VoiceGate::Delay {
+                    // the anchor's own cone: sin θ = cos ε · sin φ of its bearing φ from the
+                    // microphone axis; compared in sin θ = c·τ/d, the delay's units
+                    let rel = wrap(bearing_from([mics[0], mics[1]], a.position) - robot_yaw);
+                    let d = (cone.sin() - el.cos() * rel.sin()).abs();
+                    return (rel.cos() >= 0.0 && d <= gate.sin()).then_some((k, d));
+                }
                 let az = wrap(doa::azimuth(cone, el) + robot_yaw);
                 let db = wrap(bearing_from([mics[0], mics[1]], a.position) - az).abs();
                 (db <= gate).then_some((k, db))
@@ -398,6 +424,33 @@ mod tests {
         assert_eq!(category(speaking, looking), 2);
         // a direction between the two people lands on nobody
         assert_eq!(f.sound(0.0, (-5f64).to_radians(), mics, 0.0), None);
+    }
+
+    /// A person at 60° whose sound reads 12° too close to broadside (the reverberant bias):
+    /// outside the azimuth gate of 10°, inside the delay gate (sin 60° − sin 48° = 0.12 <
+    /// sin 10° = 0.17); at broadside the two gates agree.
+    #[test]
+    fn the_delay_gate_widens_towards_the_axis_and_equals_the_azimuth_gate_at_broadside() {
+        for (space, want) in [(VoiceGate::Delay, true), (VoiceGate::Azimuth, false)] {
+            let heard = |deg_person: f64, deg_sound: f64| {
+                let p = FusionParams {
+                    voice_gate_space: space,
+                    ..FusionParams::default()
+                };
+                let mut f = Fusion::new(p, Modalities::ALL);
+                let (id, position) = (3, at(2.0, deg_person));
+                f.legs(0.0, &[LegTrack { id, position }]);
+                // microphones at the mouth's height: no elevation
+                let mics = [0.0, 0.0, f.anchors[0].mouth_z()];
+                f.sound(0.0, deg_sound.to_radians(), mics, 0.0).is_some()
+            };
+            assert_eq!(heard(60.0, 48.0), want, "{space:?} at 60°");
+            assert!(heard(0.0, 9.5), "{space:?}: 9.5° off at broadside lands");
+            assert!(
+                !heard(0.0, 10.5),
+                "{space:?}: 10.5° off at broadside does not"
+            );
+        }
     }
 
     #[test]
