@@ -255,9 +255,10 @@ impl GccPhat {
         };
         let mut sum = vec![Complex::new(0.0, 0.0); n / 2 + 1];
         let rho = self.params.onset;
-        let mut prev: Option<Vec<f64>> = None;
+        // each frame's bin powers and the previous frame's, two buffers swapped per frame
+        let (mut power, mut before) = (vec![0.0; n / 2 + 1], vec![0.0; n / 2 + 1]);
         let mut frames = 0;
-        for &start in &keep {
+        for (i, &start) in keep.iter().enumerate() {
             self.fft_frame(&x0[start..start + n], true)?;
             self.fft_frame(&x1[start..start + n], false)?;
             let spectra = self.spec0.iter().zip(&self.spec1);
@@ -268,17 +269,16 @@ impl GccPhat {
                 frames += 1;
                 continue;
             }
-            let power: Vec<f64> = spectra
-                .clone()
-                .map(|(a, b)| 0.5 * (a.norm_sqr() + b.norm_sqr()))
-                .collect();
-            if let Some(before) = &prev {
+            for (p, (a, b)) in power.iter_mut().zip(spectra.clone()) {
+                *p = 0.5 * (a.norm_sqr() + b.norm_sqr());
+            }
+            if i > 0 {
                 for (k, (s, (a, b))) in sum.iter_mut().zip(spectra).enumerate() {
                     *s += b * a.conj() * onset_weight(power[k], before[k], rho);
                 }
                 frames += 1;
             }
-            prev = Some(power);
+            std::mem::swap(&mut power, &mut before);
         }
         let bin_hz = self.params.sample_rate / n as f64;
         for (k, s) in sum.iter_mut().enumerate() {
