@@ -28,6 +28,14 @@
 //! normalised correlation with the template is below `reacquire_corr`, the track is dropped as
 //! by `rst` and re-acquired by colour.
 //!
+//! **Other people** (our addition, off in the paper's configuration: `FollowParams::others`).
+//! The follower also tracks every blob the target did not take, and a blob one of those
+//! tracks predicts well counts less as the target's: the target's marginal of a JPDA over it
+//! and the others, fed to the PDAF as a factor on the likelihood ratio ([`others`]). A
+//! companion in the gate while the target's own blob is missing is then explained by the
+//! companion's own track; the filter coasts and, if the gap lasts, `rst` fires and colour
+//! re-acquires.
+//!
 //! **Blobs** (our reading of "connected components that might have originated from people"):
 //! jump-distance segments ([`crate::laser::segment`]) merged while the gap between the end of
 //! one and the start of the next is under `merge_gap_m` (a person's two legs), kept when at
@@ -48,6 +56,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::track::pdaf::{AssociationKind, FilterError, FilterParams, ModelKind, TargetFilter};
 use crate::vision::cylinder::{self, CorrForm, CylinderMap};
+
+pub mod others;
+use others::{Others, OthersParams, Shared};
 
 /// The default floor on the normalised correlation (a correlation coefficient, ≤ 1) with the
 /// template for re-acquisition after `rst`: see `FollowParams::default`.
@@ -93,6 +104,9 @@ pub struct FollowParams {
     /// normalised correlation with the template is below `reacquire_corr`, the track is
     /// dropped as by `rst` and re-acquired by colour (see the module doc).
     pub colour_watch_s: Option<f64>,
+    /// Our addition, off in the paper's configuration: tracks of the other people, whose
+    /// blobs then count less as the target's ([`others`]).
+    pub others: Option<OthersParams>,
 }
 
 impl Default for FollowParams {
@@ -121,6 +135,7 @@ impl Default for FollowParams {
             reinit_max_m: 10.0,
             cylinder: [720, 120],
             colour_watch_s: None,
+            others: None,
         }
     }
 }
@@ -160,6 +175,9 @@ pub struct FollowSpec {
     pub reinit_max_m: f64,
     /// The colour watchdog (our addition; absent: off, the paper's tracker).
     pub colour_watch_s: Option<f64>,
+    /// Tracks of the other people discount their blobs (our addition, [`others`]; false: the
+    /// paper's tracker).
+    pub others: bool,
 }
 
 impl Default for FollowSpec {
@@ -195,6 +213,7 @@ impl Default for FollowSpec {
             reinit_radius_m: p.reinit_radius_m,
             reinit_max_m: p.reinit_max_m,
             colour_watch_s: p.colour_watch_s,
+            others: p.others.is_some(),
         }
     }
 }
@@ -242,6 +261,7 @@ impl FollowSpec {
             reinit_max_m: self.reinit_max_m,
             cylinder: FollowParams::default().cylinder,
             colour_watch_s: self.colour_watch_s,
+            others: self.others.then(OthersParams::default),
         }
     }
 
@@ -456,6 +476,8 @@ pub struct FollowTracker {
     map: Option<CylinderMap>,
     /// Since when the track has been fed only by blobs of the wrong colour (the watchdog).
     off_colour_since: Option<f64>,
+    /// The other people's tracks (`FollowParams::others`).
+    others: Option<Others>,
 }
 
 /// One scan's blobs with what colour says about them.
@@ -479,11 +501,30 @@ impl FollowTracker {
             started: false,
             map: None,
             off_colour_since: None,
+            others: params.others.as_ref().map(Others::new),
         }
     }
 
     pub fn params(&self) -> &FollowParams {
         &self.params
+    }
+
+    /// The filter's values the other people's tracks share.
+    fn shared(&self) -> Shared {
+        let f = &self.params.filter;
+        Shared {
+            sigma_r: f.sigma_r,
+            p_d: f.p_d,
+            gate: f.gate,
+            clutter_density: f.clutter_density,
+        }
+    }
+
+    /// The other people's confirmed tracks (empty when `FollowParams::others` is off).
+    pub fn other_people(&self) -> Vec<[f64; 2]> {
+        self.others
+            .as_ref()
+            .map_or_else(Vec::new, Others::confirmed)
     }
 
     /// Drop the track as `rst` does (e.g. after a filter error): the next scans look for the
@@ -560,13 +601,35 @@ impl FollowTracker {
             lr: &lr,
             corr: &corr,
         };
+        let z: Vec<[f64; 2]> = bl.iter().map(|b| b.centre).collect();
+        let shared = self.shared();
+        if let Some(o) = self.others.as_mut() {
+            o.predict(obs.t);
+        }
         let Some(filter) = self.filter.as_mut() else {
-            self.initialise(obs.t, &seen, &mut out);
+            let taken = self.initialise(obs.t, &seen, &mut out);
+            if let Some(o) = self.others.as_mut() {
+                if let Some(j) = taken {
+                    o.forget_near(z[j], &shared);
+                }
+                o.update(obs.t, &z, taken, &shared);
+            }
             return Ok(out);
         };
         filter.predict(obs.t)?;
-        let z: Vec<[f64; 2]> = bl.iter().map(|b| b.centre).collect();
-        let a = filter.update(&z, &lr)?;
+        let a = match self.others.as_ref() {
+            Some(o) => {
+                let f = o.discount(&z, &shared);
+                let lr_others: Vec<f64> = lr.iter().zip(&f).map(|(l, f)| l * f).collect();
+                filter.update(&z, &lr_others)?
+            }
+            None => filter.update(&z, &lr)?,
+        };
+        if let Some(o) = self.others.as_mut() {
+            let taken = a.chosen.filter(|&j| a.beta[j] > a.beta0);
+            o.update(obs.t, &z, taken, &shared);
+            o.coalesce(filter.position(), filter.position_covariance());
+        }
         out.gated = a.gated.len();
         out.beta0 = Some(a.beta0);
         let needs_reset = filter.needs_reset();
@@ -628,8 +691,8 @@ impl FollowTracker {
         }
     }
 
-    /// Start (or restart after `rst`): see the module doc.
-    fn initialise(&mut self, t: f64, seen: &Seen<'_>, out: &mut StepOutput) {
+    /// Start (or restart after `rst`): see the module doc. Returns the blob taken.
+    fn initialise(&mut self, t: f64, seen: &Seen<'_>, out: &mut StepOutput) -> Option<usize> {
         let radius = match (self.started, self.lost_at) {
             (false, _) => self.params.init_radius_m,
             (true, lost) => (self.params.reinit_radius_m
@@ -641,7 +704,7 @@ impl FollowTracker {
         let pick = pick_blob(seen, self.anchor, radius, floor).map(|j| (j, &seen.blobs[j]));
         let Some((j, b)) = pick else {
             out.look_at = self.started.then_some(self.anchor);
-            return;
+            return None;
         };
         let filter = TargetFilter::new(&self.params.filter, t, b.centre);
         if self.template.is_none()
@@ -658,6 +721,7 @@ impl FollowTracker {
         self.started = true;
         self.lost_at = None;
         self.off_colour_since = None;
+        Some(j)
     }
 }
 

@@ -263,3 +263,60 @@ fn a_non_positive_watchdog_time_is_named() {
     );
     assert!(FollowSpec::default().problems().is_empty());
 }
+
+/// A companion walks 1 m beside the person, both away from the laser at 1.5 m/s; the person's
+/// blob is missing for 0.8 s (hidden). With a gate wide enough to hold both (χ² 30) and no
+/// colour, the paper's PDAF takes the companion's blob, the only one, as the target's and
+/// ends on the companion; with the other people tracked (`FollowParams::others`) the
+/// companion's blob is explained by its own track, the filter coasts through the gap and ends
+/// on the person.
+#[test]
+fn other_people_keep_a_companion_from_capturing_the_track() {
+    let at = |t: f64| 2.0 + 1.5 * t;
+    let run = |others: bool| {
+        let mut p = params(ModelKind::Ct);
+        p.filter.gate = 30.0;
+        p.others = others.then(OthersParams::default);
+        let mut tr = FollowTracker::new(&p, [2.0, 0.0]);
+        let mut worst: f64 = 0.0;
+        let mut last = [f64::NAN; 2];
+        for k in 0..50 {
+            let t = 0.1 * f64::from(k);
+            let mut world = legs(at(t), 1.0).to_vec();
+            if !(20..28).contains(&k) {
+                world.extend(legs(at(t), 0.0));
+            }
+            let pts = scan(&world);
+            let out = tr
+                .step(&ScanObs {
+                    t,
+                    points: &pts,
+                    omni: None,
+                })
+                .expect("step");
+            if let Some(e) = out.estimate {
+                last = e.position;
+                if k >= 10 {
+                    worst = worst.max((e.position[0] - at(t)).hypot(e.position[1]));
+                }
+            }
+            if others && k == 19 {
+                assert_eq!(tr.other_people().len(), 1, "the companion is tracked");
+            }
+        }
+        ((last[0] - at(4.9)).hypot(last[1]), worst)
+    };
+    let (paper_end, _) = run(false);
+    let (ours_end, ours_worst) = run(true);
+    eprintln!(
+        "paper: {paper_end:.3} m from the person at the end; ours: {ours_end:.3} m (worst {ours_worst:.3})"
+    );
+    assert!(
+        paper_end > 0.7,
+        "the paper's PDAF was not captured: {paper_end}"
+    );
+    assert!(
+        ours_end < 0.2 && ours_worst < 0.5,
+        "{ours_end}, {ours_worst}"
+    );
+}
