@@ -326,6 +326,18 @@ pub fn ttests(data: &[&SessionData], p: &Params) -> Vec<TestRow> {
             lvl,
         ));
     }
+    let o = params::OTHERS;
+    if has(c) && has(o) {
+        let f = |r: &MethodRow| Some(r.on_target);
+        out.push(paired(
+            "other people tracked (ours): off (the paper) vs on",
+            "run",
+            "share of scans within lock_m of the person",
+            (c, &per_run(c, &f)),
+            (o, &per_run(o, &f)),
+            lvl,
+        ));
+    }
     let up = params::UPDATED;
     if has(c) && has(up) {
         let q = "colour template: held vs updated";
@@ -418,10 +430,10 @@ fn literal_readings(data: &[&SessionData], p: &Params) -> Vec<TestRow> {
     out
 }
 
-fn replay_rows(data: &[&SessionData]) -> Vec<ReplayRow> {
+fn replay_rows(data: &[&SessionData], p: &Params) -> Vec<ReplayRow> {
     data.iter()
         .map(|d| {
-            let rows: Vec<&TrackRow> = d.method(params::PAPER).collect();
+            let rows: Vec<&TrackRow> = d.method(&p.loop_method).collect();
             let mut dist = Vec::new();
             for l in d.closed_loop.iter().filter(|l| l.x.is_some()) {
                 let near = rows
@@ -471,8 +483,8 @@ pub fn tables(data: &[&SessionData], p: &Params) -> anyhow::Result<Vec<Table>> {
         tm = tm.with_precision(c, 3);
     }
     let tm = tm.with_note(format!(
-        "Open-loop replays of the same logs (the robot was driven by the paper's configuration, {}). ct = coordinated turn (EKF), cv = constant velocity, imm = IMM of both (ours); colour = the HS-histogram likelihood ratio; nn = nearest neighbour; laser_tracker = the laser issue's multi-person tracker, nearest track followed. Error in map; lock radius {} m.",
-        params::PAPER, p.lock_m
+        "Open-loop replays of the same logs (the robot was driven by its own tracker, the configuration {}); ct_colour_others = ours: the other people tracked, their blobs discounted. ct = coordinated turn (EKF), cv = constant velocity, imm = IMM of both (ours); colour = the HS-histogram likelihood ratio; nn = nearest neighbour; laser_tracker = the laser issue's multi-person tracker, nearest track followed. Error in map; lock radius {} m.",
+        p.loop_method, p.lock_m
     ));
     let mut tt = Table::new(
         "ttests",
@@ -489,7 +501,7 @@ pub fn tables(data: &[&SessionData], p: &Params) -> anyhow::Result<Vec<Table>> {
     let mut tr = Table::new(
         "replay_check",
         "The replayed paper configuration vs the closed loop's own logged estimates",
-        ReplayRow::frame(&replay_rows(data))?,
+        ReplayRow::frame(&replay_rows(data, p))?,
     );
     tr = tr
         .with_precision("mean_distance_m", 3)

@@ -43,7 +43,7 @@ pub struct KobilarovFollowing;
 
 impl Experiment for KobilarovFollowing {
     const KIND: &'static str = "s001_kobilarov_following";
-    const VERSION: u32 = 4; // 4: `colour` rows gained the offset from the target (tdx, tdy)
+    const VERSION: u32 = 5; // 5: ct_colour_others (the other people tracked) and loop_method
     const SESSION_TABLES: &'static [crate::run::schemas::TableDoc] = tables::SESSION_TABLES;
     type Params = Params;
 

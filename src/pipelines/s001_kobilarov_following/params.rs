@@ -43,6 +43,10 @@ pub struct Params {
     pub max_decel_mps2: f64,
     /// Methods replayed on every log, in table order (see [`method`]).
     pub methods: Vec<String>,
+    /// The replayed method that is the closed loop's own configuration (the scenario's
+    /// `[robot.follow] pdaf` settings): `replay_check` compares it with the loop's logged
+    /// estimates, and the `rst` causes use its last accepted measurement. One of `methods`.
+    pub loop_method: String,
     pub follower: FollowSpec,
     /// Weight of the newest histogram in the updated template (`ct_colour_updated`), per scan
     /// with an association.
@@ -96,6 +100,7 @@ impl Default for Params {
             following_distance_m: 3.2,
             max_decel_mps2: 1.4,
             methods: METHODS.iter().map(|m| (*m).to_string()).collect(),
+            loop_method: PAPER.into(),
             follower: FollowSpec::default(),
             template_update: 0.05,
             colour_watch_s: 1.0,
@@ -118,33 +123,54 @@ impl Default for Params {
     }
 }
 
+/// A configuration of `laser::follow`'s follower, as a replayed method.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Variant {
+    pub model: ModelKind,
+    pub association: AssociationKind,
+    pub colour: bool,
+    /// The colour template follows the target (`template_update` per scan) instead of
+    /// staying as taken at initialisation.
+    pub update: bool,
+    /// corr as printed (no square root) instead of the normalised form.
+    pub printed: bool,
+    /// `rst` at the paper's literal "usually 5" σ_r
+    /// ([`crate::track::pdaf::RESET_SIGMAS_LITERAL`]) instead of the multiplier derived from
+    /// its reset timing (`follower.reset_sigmas`).
+    pub literal_rst: bool,
+    /// The colour watchdog (our addition, `laser::follow::FollowParams::colour_watch_s`) at
+    /// `colour_watch_s`.
+    pub colour_watch: bool,
+    /// The other people tracked, their blobs discounted (our addition,
+    /// `laser::follow::others`).
+    pub others: bool,
+}
+
+impl Variant {
+    /// The paper's configuration: coordinated turn, PDAF, colour, template held.
+    pub const PAPER: Variant = Variant {
+        model: ModelKind::Ct,
+        association: AssociationKind::Pdaf,
+        colour: true,
+        update: false,
+        printed: false,
+        literal_rst: false,
+        colour_watch: false,
+        others: false,
+    };
+}
+
 /// One replayed method.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Method {
     /// The follower of `laser::follow`.
-    Follower {
-        model: ModelKind,
-        association: AssociationKind,
-        colour: bool,
-        /// The colour template follows the target (`template_update` per scan) instead of
-        /// staying as taken at initialisation.
-        update: bool,
-        /// corr as printed (no square root) instead of the normalised form.
-        printed: bool,
-        /// `rst` at the paper's literal "usually 5" σ_r
-        /// ([`crate::track::pdaf::RESET_SIGMAS_LITERAL`]) instead of the multiplier derived
-        /// from its reset timing (`follower.reset_sigmas`).
-        literal_rst: bool,
-        /// The colour watchdog (our addition, `laser::follow::FollowParams::colour_watch_s`)
-        /// at `colour_watch_s`.
-        colour_watch: bool,
-    },
+    Follower(Variant),
     /// The laser issue's multi-person tracker (`laser::tracker`), its track nearest the
     /// target followed.
     LaserTracker,
 }
 
-/// The paper's configuration (drives the closed loop): coordinated turn, PDAF, colour.
+/// The paper's configuration: coordinated turn, PDAF, colour.
 pub const PAPER: &str = "ct_colour";
 /// The same with the template updated while tracking (the paper allows both).
 pub const UPDATED: &str = "ct_colour_updated";
@@ -154,18 +180,22 @@ pub const PRINTED: &str = "ct_colour_printed";
 pub const RST5: &str = "ct_colour_rst5";
 /// Our addition: the paper's configuration with the colour watchdog (`colour_watch_s`).
 pub const WATCH: &str = "ct_colour_watch";
+/// Our addition: the paper's configuration with the other people tracked
+/// (`laser::follow::others`).
+pub const OTHERS: &str = "ct_colour_others";
 pub const CV: &str = "cv_colour";
 pub const IMM: &str = "imm_colour";
 pub const NO_COLOUR: &str = "ct_no_colour";
 pub const NN: &str = "nn_ct";
 pub const LASER_TRACKER: &str = "laser_tracker";
 /// Every known method, in the default table order.
-pub const METHODS: [&str; 10] = [
+pub const METHODS: [&str; 11] = [
     PAPER,
     UPDATED,
     PRINTED,
     RST5,
     WATCH,
+    OTHERS,
     CV,
     IMM,
     NO_COLOUR,
@@ -175,56 +205,34 @@ pub const METHODS: [&str; 10] = [
 
 /// The method a name stands for.
 pub fn method(name: &str) -> Option<Method> {
-    use AssociationKind::{Nearest, Pdaf};
-    use ModelKind::{Ct, Cv, Imm};
-    let f = |model, association, colour, update| {
-        Some(Method::Follower {
-            model,
-            association,
-            colour,
-            update,
-            printed: false,
-            literal_rst: false,
-            colour_watch: false,
-        })
-    };
-    match name {
-        PAPER => f(Ct, Pdaf, true, false),
-        UPDATED => f(Ct, Pdaf, true, true),
-        PRINTED => Some(Method::Follower {
-            model: Ct,
-            association: Pdaf,
-            colour: true,
-            update: false,
-            printed: true,
-            literal_rst: false,
-            colour_watch: false,
-        }),
-        RST5 => Some(Method::Follower {
-            model: Ct,
-            association: Pdaf,
-            colour: true,
-            update: false,
-            printed: false,
+    use AssociationKind::Nearest;
+    use ModelKind::{Cv, Imm};
+    let p = Variant::PAPER;
+    let v = match name {
+        PAPER => p,
+        UPDATED => Variant { update: true, ..p },
+        PRINTED => Variant { printed: true, ..p },
+        RST5 => Variant {
             literal_rst: true,
-            colour_watch: false,
-        }),
-        WATCH => Some(Method::Follower {
-            model: Ct,
-            association: Pdaf,
-            colour: true,
-            update: false,
-            printed: false,
-            literal_rst: false,
+            ..p
+        },
+        WATCH => Variant {
             colour_watch: true,
-        }),
-        CV => f(Cv, Pdaf, true, false),
-        IMM => f(Imm, Pdaf, true, false),
-        NO_COLOUR => f(Ct, Pdaf, false, false),
-        NN => f(Ct, Nearest, false, false),
-        LASER_TRACKER => Some(Method::LaserTracker),
-        _ => None,
-    }
+            ..p
+        },
+        OTHERS => Variant { others: true, ..p },
+        CV => Variant { model: Cv, ..p },
+        IMM => Variant { model: Imm, ..p },
+        NO_COLOUR => Variant { colour: false, ..p },
+        NN => Variant {
+            association: Nearest,
+            colour: false,
+            ..p
+        },
+        LASER_TRACKER => return Some(Method::LaserTracker),
+        _ => return None,
+    };
+    Some(Method::Follower(v))
 }
 
 impl Params {
@@ -294,8 +302,45 @@ pub(super) fn validate(p: &Params) -> Vec<Invalid> {
             ));
         }
     }
+    if !p.methods.contains(&p.loop_method) {
+        out.push((
+            "loop_method".into(),
+            format!(
+                "{:?} is not one of `methods` (the closed loop's configuration must be replayed)",
+                p.loop_method
+            ),
+        ));
+    }
     for (k, reason) in p.follower.problems() {
         out.push((format!("follower.{k}"), reason));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every method name resolves, the defaults validate, and a loop method that is not
+    /// replayed is refused by name.
+    #[test]
+    fn methods_resolve_and_the_loop_method_must_be_replayed() {
+        assert!(METHODS.iter().all(|m| method(m).is_some()));
+        assert_eq!(
+            method(OTHERS),
+            Some(Method::Follower(Variant {
+                others: true,
+                ..Variant::PAPER
+            }))
+        );
+        assert!(validate(&Params::default()).is_empty());
+        let p = Params {
+            methods: vec![PAPER.into()],
+            loop_method: OTHERS.into(),
+            ..Params::default()
+        };
+        let problems = validate(&p);
+        assert_eq!(problems.len(), 1, "{problems:?}");
+        assert_eq!(problems[0].0, "loop_method");
+    }
 }

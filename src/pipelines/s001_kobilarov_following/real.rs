@@ -1,12 +1,13 @@
 //! A real laser log (Leigh et al.'s annotated person-following sequence): no camera, no
 //! odometry, so every follower runs laser only in the laser frame (colour off: a method that
-//! differs from another only by colour or corr is run once; the literal `rst` is kept), beside the laser issue's multi-person
+//! differs from another only by colour or corr is run once; the literal `rst` and the other
+//! people's tracks are kept), beside the laser issue's multi-person
 //! tracker. Each starts at the first annotation; every annotation belongs to the last scan
 //! logged before it (the authors' rule) and is scored against the estimate of that scan.
 
 use anyhow::Context;
 
-use super::params::{self, Method, Params, RealSequence};
+use super::params::{self, Method, Params, RealSequence, Variant};
 use super::replay::Runner;
 use super::tables::{self, RealRow};
 use crate::frames::laser::{self as laser_frames, LaserOptions};
@@ -26,20 +27,14 @@ pub fn methods(p: &Params) -> Vec<(String, Method)> {
             continue;
         };
         let m = match m {
-            Method::Follower {
-                model,
-                association,
-                literal_rst,
-                ..
-            } => Method::Follower {
-                model,
-                association,
+            Method::Follower(v) => Method::Follower(Variant {
+                model: v.model,
+                association: v.association,
                 colour: false,
-                update: false,
-                printed: false,
-                literal_rst,
-                colour_watch: false,
-            },
+                literal_rst: v.literal_rst,
+                others: v.others,
+                ..Variant::PAPER
+            }),
             other => other,
         };
         if !out.iter().any(|(_, o)| *o == m) {

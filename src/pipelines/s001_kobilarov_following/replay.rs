@@ -30,27 +30,22 @@ pub struct LaserSelect {
 impl Runner {
     pub fn new(method: Method, p: &Params, init: [f64; 2]) -> Runner {
         match method {
-            Method::Follower {
-                model,
-                association,
-                colour,
-                update,
-                printed,
-                literal_rst,
-                colour_watch,
-            } => {
-                let mut fp = p.follower.params(model, association, colour);
-                if update {
+            Method::Follower(v) => {
+                let mut fp = p.follower.params(v.model, v.association, v.colour);
+                if v.update {
                     fp.template_update = p.template_update;
                 }
-                if printed {
+                if v.printed {
                     fp.corr_form = crate::vision::cylinder::CorrForm::Printed;
                 }
-                if literal_rst {
+                if v.literal_rst {
                     fp.filter.reset_sigmas = crate::track::pdaf::RESET_SIGMAS_LITERAL;
                 }
-                if colour_watch {
+                if v.colour_watch {
                     fp.colour_watch_s = Some(p.colour_watch_s);
+                }
+                if v.others {
+                    fp.others = Some(crate::laser::follow::others::OthersParams::default());
                 }
                 Runner::Follower(Box::new(FollowTracker::new(&fp, init)))
             }

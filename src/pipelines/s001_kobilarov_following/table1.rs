@@ -221,7 +221,7 @@ pub fn table1_rows(data: &[&SessionData], p: &Params) -> Vec<Table1Row> {
 pub fn events(d: &SessionData, p: &Params) -> Vec<RstRow> {
     let mut out = Vec::new();
     for (i, r) in d.closed_loop.iter().enumerate().filter(|(_, r)| r.reset) {
-        let since = last_accepted(d, r.t_s)
+        let since = last_accepted(d, r.t_s, p)
             .unwrap_or(r.t_s - 3.0)
             .max(r.t_s - 3.0);
         let before: Vec<&TruthRow> = d
@@ -265,9 +265,10 @@ pub fn events(d: &SessionData, p: &Params) -> Vec<RstRow> {
     out
 }
 
-/// The last scan before `t` on which the replayed paper configuration accepted a measurement.
-fn last_accepted(d: &SessionData, t: f64) -> Option<f64> {
-    d.method(super::params::PAPER)
+/// The last scan before `t` on which the replayed loop configuration (`loop_method`) accepted
+/// a measurement.
+fn last_accepted(d: &SessionData, t: f64, p: &Params) -> Option<f64> {
+    d.method(&p.loop_method)
         .filter(|q| q.t_s < t - 1e-6 && q.gated > 0)
         .map(|q| q.t_s)
         .last()
