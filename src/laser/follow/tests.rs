@@ -34,6 +34,17 @@ fn scan(circles: &[(f64, f64, f64)]) -> Vec<ScanPoint> {
     out
 }
 
+/// One scan of `world` at time `t` through the follower (no omni frame).
+fn step(tr: &mut FollowTracker, t: f64, world: &[(f64, f64, f64)]) -> StepOutput {
+    let pts = scan(world);
+    tr.step(&ScanObs {
+        t,
+        points: &pts,
+        omni: None,
+    })
+    .expect("step")
+}
+
 fn legs(x: f64, y: f64) -> [(f64, f64, f64); 2] {
     [(x, y - 0.13, 0.06), (x, y + 0.13, 0.06)]
 }
@@ -80,14 +91,7 @@ fn follows_a_walker_past_a_post() {
             let y = -2.0 + 1.5 * t;
             let mut world = legs(4.0, y).to_vec();
             world.push((post[0], post[1], 0.08));
-            let pts = scan(&world);
-            let out = tr
-                .step(&ScanObs {
-                    t,
-                    points: &pts,
-                    omni: None,
-                })
-                .expect("step");
+            let out = step(&mut tr, t, &world);
             assert!(!out.reset, "{model:?} reset at {t}");
             let e = out.estimate.expect("tracked");
             last = (e.position[0] - 3.97).hypot(e.position[1] - y);
@@ -116,14 +120,7 @@ fn reset_then_reinitialise_on_the_nearest_blob() {
         } else {
             Vec::new()
         };
-        let pts = scan(&world);
-        let out = tr
-            .step(&ScanObs {
-                t,
-                points: &pts,
-                omni: None,
-            })
-            .expect("step");
+        let out = step(&mut tr, t, &world);
         if out.reset && reset_at.is_none() {
             reset_at = Some(k);
             assert!(out.estimate.is_none());
@@ -198,14 +195,7 @@ fn a_lost_follower_reports_where_it_lost_the_target() {
         } else {
             Vec::new()
         };
-        let pts = scan(&world);
-        let out = tr
-            .step(&ScanObs {
-                t,
-                points: &pts,
-                omni: None,
-            })
-            .expect("step");
+        let out = step(&mut tr, t, &world);
         if out.reset {
             reset_look = out.look_at;
         }
@@ -286,14 +276,7 @@ fn other_people_keep_a_companion_from_capturing_the_track() {
             if !(20..28).contains(&k) {
                 world.extend(legs(at(t), 0.0));
             }
-            let pts = scan(&world);
-            let out = tr
-                .step(&ScanObs {
-                    t,
-                    points: &pts,
-                    omni: None,
-                })
-                .expect("step");
+            let out = step(&mut tr, t, &world);
             if let Some(e) = out.estimate {
                 last = e.position;
                 if k >= 10 {
