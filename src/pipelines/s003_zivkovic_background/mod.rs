@@ -164,7 +164,8 @@ impl Experiment for BackgroundTracking {
     // 5: re-identification features (`reid_frames`) for `reid.datasets`
     // 6: `reid_frames` per box and pixel set (tracker foreground, exact id mask, box), raw
     //    region means and frame means; `reid.train_datasets` too
-    const VERSION: u32 = 6;
+    // 7: `reid_frames` also for the filled foreground (`person_filled`)
+    const VERSION: u32 = 7;
     const SESSION_TABLES: &'static [TableDoc] = SESSION_TABLES;
     type Params = Params;
 

@@ -15,6 +15,9 @@
 //!   person it overlaps most.
 //! - `box`: every pixel of the box, background included (the feature before issue 31, kept
 //!   to measure what the person's pixels change).
+//! - `person_filled` (issue 31, round 6): the tracker's foreground with every row of the box
+//!   filled from its first to its last foreground pixel — the silhouette with the holes closed
+//!   where the person's colour is too like the background behind for the mask.
 //!
 //! **The regions** (fig. 4a): three horizontal regions of 25 % of "the blob's height" with
 //! "skip areas" of 12.5 %. For the mask sets the blob is the set's pixels inside the box and
@@ -55,6 +58,7 @@ pub(super) const MIN_REGION_PX: u64 = 10;
 pub(super) const PERSON: &str = "person";
 pub(super) const EXACT: &str = "exact";
 pub(super) const BOX: &str = "box";
+pub(super) const FILLED: &str = "person_filled";
 
 table_row! {
     /// Cached per session: the region means of one box's pixel set in one frame.
@@ -68,7 +72,7 @@ table_row! {
         pub id: i64,
         /// The ground-truth person a system box overlaps most (IoU ≥ `local_eval.min_iou`).
         pub truth_id: Option<i64>,
-        /// `person`, `exact` or `box` (the module doc).
+        /// `person`, `person_filled`, `exact` or `box` (the module doc).
         pub pixels: String,
         /// Pixels of the set inside the box.
         pub px: i64,
@@ -142,6 +146,10 @@ pub(super) enum Pixels<'a> {
     /// Pixels where the row-major `mask` (the image's size) equals `value`; the regions split
     /// the height of those pixels' extent.
     Where { mask: &'a [u8], value: u8 },
+    /// As `Where`, each row of the box filled from its first to its last such pixel: the
+    /// blob's silhouette with its holes closed (the parts of a person too like the background
+    /// behind them for the mask).
+    Spans { mask: &'a [u8], value: u8 },
 }
 
 /// Rows `[y0, y1)` of the three regions of a blob spanning rows `top..bottom` (fractional for
@@ -167,18 +175,36 @@ pub(super) fn region_means(rgb: &RgbImage, b: [f64; 4], pixels: Pixels) -> Optio
     if x1 <= x0 {
         return None;
     }
+    let ys = (b[1].max(0.0).floor() as u32)..(b[3].min(f64::from(h)).ceil() as u32);
+    let is = |mask: &[u8], value: u8, x: u32, y: u32| {
+        mask.get(y as usize * w as usize + x as usize) == Some(&value)
+    };
+    // per row of the box, the first and last column of the mask's value (Spans only)
+    let spans: Vec<Option<(u32, u32)>> = match pixels {
+        Pixels::Spans { mask, value } => ys
+            .clone()
+            .map(|y| {
+                let first = (x0..x1).find(|&x| is(mask, value, x, y))?;
+                let last = (x0..x1).rev().find(|&x| is(mask, value, x, y))?;
+                Some((first, last))
+            })
+            .collect(),
+        _ => Vec::new(),
+    };
     let selected = |x: u32, y: u32| match pixels {
         Pixels::All => true,
-        Pixels::Where { mask, value } => {
-            mask.get(y as usize * w as usize + x as usize) == Some(&value)
-        }
+        Pixels::Where { mask, value } => is(mask, value, x, y),
+        Pixels::Spans { .. } => spans
+            .get(y.wrapping_sub(ys.start) as usize)
+            .copied()
+            .flatten()
+            .is_some_and(|(a, z)| (a..=z).contains(&x)),
     };
     let (rows, least, in_box) = match pixels {
         Pixels::All => (region_rows(b[1], b[3], f64::from(h)), 1, 0),
-        Pixels::Where { .. } => {
-            let ys = (b[1].max(0.0).floor() as u32)..(b[3].min(f64::from(h)).ceil() as u32);
+        Pixels::Where { .. } | Pixels::Spans { .. } => {
             let (mut top, mut bottom, mut n) = (u32::MAX, 0u32, 0u64);
-            for y in ys {
+            for y in ys.clone() {
                 let k = (x0..x1).filter(|&x| selected(x, y)).count() as u64;
                 if k > 0 {
                     top = top.min(y);
@@ -313,9 +339,14 @@ impl ReidRun {
             mask,
             value: FOREGROUND,
         });
+        let filled_px = foreground.map(|mask| Pixels::Spans {
+            mask,
+            value: FOREGROUND,
+        });
         for (name, pixels) in [
             (BOX, Some(Pixels::All)),
             (PERSON, person_px),
+            (FILLED, filled_px),
             (EXACT, exact),
         ] {
             if let Some((m, px)) = pixels.and_then(|p| region_means(f.rgb, b, p)) {
@@ -410,6 +441,40 @@ mod tests {
             value: 7,
         };
         assert_eq!(region_means(&img, b, thin), None);
+        // the filled set closes a hole: rows 6..8, columns 3..5 of the person are dark red and
+        // missed by the mask; `Where` keeps columns 2 and 5 there (green), `Spans` all four
+        let img2 = RgbImage::from_fn(10, 20, |x, y| {
+            if person(x, y) && (6..8).contains(&y) && (3..5).contains(&x) {
+                image::Rgb([100, 0, 0])
+            } else {
+                *img.get_pixel(x, y)
+            }
+        });
+        let holed: Vec<u8> = (0..200u32)
+            .map(|i| {
+                let (x, y) = (i % 10, i / 10);
+                u8::from(person(x, y) && !((6..8).contains(&y) && (3..5).contains(&x))) * 7
+            })
+            .collect();
+        let (w, _) = region_means(
+            &img2,
+            b,
+            Pixels::Where {
+                mask: &holed,
+                value: 7,
+            },
+        )
+        .expect("w");
+        assert_eq!(w[..3], [0.0, 200.0, 0.0], "the mask alone misses the red");
+        let spans = Pixels::Spans {
+            mask: &holed,
+            value: 7,
+        };
+        let (f, px) = region_means(&img2, b, spans).expect("spans");
+        // region 1 (rows 6..10, 16 pixels): 4 red, 12 green
+        assert_eq!(f[..3], [25.0, 150.0, 0.0], "a quarter red");
+        assert_eq!(f[3..], m[3..], "rows without a hole are as before");
+        assert_eq!(px, 64, "the filled silhouette is the whole person");
         // another value of the mask is nobody here
         let other = Pixels::Where {
             mask: &mask,

@@ -11,11 +11,14 @@
 //! averages "3D" colours per region, so the feature stops after the channel normalisation:
 //! region mean / frame mean per channel (pixel-wise normalisation and the region mean
 //! commute). `ln`: the logarithm of the same ratio (the feature before issue 31: the frame's
-//! mean colour at 0). `raw`: RGB / 255.
+//! mean colour at 0). `raw`: RGB / 255. `chromaticity` (issue 31, round 6): Drew, Wei & Li's
+//! second step as well — each region's channel-normalised colour divided by the sum of its
+//! three channels (r + g + b = 1 per region), which also cancels the region's brightness
+//! (shading, the person's distance to a lamp); taken of the region's mean, not per pixel.
 
 use std::collections::BTreeMap;
 
-use super::reid::{BOX, EXACT, PERSON, ReidFrameRow};
+use super::reid::{BOX, EXACT, FILLED, PERSON, ReidFrameRow};
 use super::reid_params::ReidParams;
 use crate::track::reid::Span;
 
@@ -24,6 +27,8 @@ use crate::track::reid::Span;
 pub(super) enum PixelSet {
     /// The tracker's own foreground (the default).
     Person,
+    /// The tracker's foreground with each row filled between its first and last pixel.
+    Filled,
     /// The synthesizer's per-person mask (the ceiling).
     Exact,
     /// Every pixel of the box.
@@ -31,12 +36,18 @@ pub(super) enum PixelSet {
 }
 
 impl PixelSet {
-    pub const ALL: [PixelSet; 3] = [PixelSet::Person, PixelSet::Exact, PixelSet::Box];
+    pub const ALL: [PixelSet; 4] = [
+        PixelSet::Person,
+        PixelSet::Filled,
+        PixelSet::Exact,
+        PixelSet::Box,
+    ];
 
     /// The `pixels` value of its cached rows.
     pub fn key(self) -> &'static str {
         match self {
             PixelSet::Person => PERSON,
+            PixelSet::Filled => FILLED,
             PixelSet::Exact => EXACT,
             PixelSet::Box => BOX,
         }
@@ -49,25 +60,42 @@ pub(super) enum Space {
     Normalised,
     Ln,
     Raw,
+    Chromaticity,
 }
 
 impl Space {
-    pub const ALL: [Space; 3] = [Space::Normalised, Space::Ln, Space::Raw];
+    pub const ALL: [Space; 4] = [
+        Space::Normalised,
+        Space::Ln,
+        Space::Raw,
+        Space::Chromaticity,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
             Space::Normalised => "channel-normalised",
             Space::Ln => "ln channel-normalised",
             Space::Raw => "raw RGB",
+            Space::Chromaticity => "channel-normalised chromaticity",
         }
     }
 
     /// One frame's 9-D feature from the raw region means and the frame's channel means.
     pub fn of(self, means: [f64; 9], frame: [f64; 3]) -> [f64; 9] {
+        let normalised: [f64; 9] = std::array::from_fn(|i| means[i] / frame[i % 3]);
         std::array::from_fn(|i| match self {
-            Space::Normalised => means[i] / frame[i % 3],
+            Space::Normalised => normalised[i],
             Space::Ln => (means[i].max(1.0) / frame[i % 3]).ln(),
             Space::Raw => means[i] / 255.0,
+            Space::Chromaticity => {
+                let region = &normalised[3 * (i / 3)..3 * (i / 3) + 3];
+                let sum: f64 = region.iter().sum();
+                if sum > 0.0 {
+                    normalised[i] / sum
+                } else {
+                    1.0 / 3.0
+                }
+            }
         })
     }
 }
@@ -189,6 +217,31 @@ fn observation(id: i64, piece: &[&ReidFrameRow], inside: &[&ReidFrameRow]) -> Ob
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn chromaticity_divides_each_regions_normalised_colour_by_its_sum() {
+        let frame = [50.0, 50.0, 100.0];
+        let means = [100.0, 50.0, 50.0, 10.0, 10.0, 20.0, 0.0, 0.0, 0.0];
+        let c = Space::Chromaticity.of(means, frame);
+        // region 1: normalised (2, 1, 0.5), sum 3.5; region 2: (0.2, 0.2, 0.2); region 3 black
+        let want = [
+            2.0 / 3.5,
+            1.0 / 3.5,
+            0.5 / 3.5,
+            1.0 / 3.0,
+            1.0 / 3.0,
+            1.0 / 3.0,
+        ];
+        for (got, want) in c.iter().zip(want) {
+            assert!((got - want).abs() < 1e-12, "{c:?}");
+        }
+        assert_eq!(c[6..], [1.0 / 3.0; 3], "a black region is grey");
+        // a brighter region (shading, a lamp) has the same chromaticity; the normalised
+        // colour doubles
+        let brighter = means.map(|v| 2.0 * v);
+        assert_eq!(Space::Chromaticity.of(brighter, frame)[..6], c[..6]);
+        assert_eq!(Space::Normalised.of(brighter, frame)[0], 4.0);
+    }
 
     /// A box row and a person row of one frame: region means `v` everywhere, frame means 100.
     fn rows(t_s: f64, id: i64, v: f64, truth_id: Option<i64>, source: &str) -> Vec<ReidFrameRow> {

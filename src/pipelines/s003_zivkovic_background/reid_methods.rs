@@ -71,7 +71,7 @@ pub(super) const PAPER: Method = Method {
 };
 
 /// Every method, the paper's first; each row of `reid` and `reid_ttests` is one of them.
-pub(super) const METHODS: [Method; 10] = [
+pub(super) const METHODS: [Method; 14] = [
     PAPER,
     Method {
         name: "paper, prior moved (training split)",
@@ -120,6 +120,26 @@ pub(super) const METHODS: [Method; 10] = [
         name: "whole box, ln (before issue 31)",
         feature: (PixelSet::Box, Space::Ln),
         model: PAPER_ADF,
+    },
+    Method {
+        name: "filled silhouettes, prior moved",
+        feature: (PixelSet::Filled, NORMALISED),
+        model: TRAINED_ADF,
+    },
+    Method {
+        name: "chromaticity",
+        feature: (PixelSet::Person, Space::Chromaticity),
+        model: PAPER_ADF,
+    },
+    Method {
+        name: "chromaticity, prior moved",
+        feature: (PixelSet::Person, Space::Chromaticity),
+        model: TRAINED_ADF,
+    },
+    Method {
+        name: "ceiling: exact masks, chromaticity, prior moved",
+        feature: (PixelSet::Exact, Space::Chromaticity),
+        model: TRAINED_ADF,
     },
 ];
 

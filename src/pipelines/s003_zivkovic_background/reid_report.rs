@@ -311,7 +311,7 @@ pub(super) fn products(
             .with_precision("adjusted_rand", 3)
             .with_note("Paper (two real clips): clip 1, two places lit alike — every person identified correctly (0 errors); clip 2, across strongly different light — one of five people wrongly identified as a new person.")
             .with_note(format!("Clips: {}. Observations are local tracks (gap > {} s splits a track, fewer than {} frames dropped), filtered in order of their end; `truth` = ground-truth boxes with visibility ≥ {}, `system` = the local tracker's tracks, each scored as the person it overlaps most (IoU ≥ local_eval.min_iou; `no_person` = tracks on no person, filtered but not scored). `no_feature` = tracks of the clip none of whose frames gave the method's pixels (the camera moving, the model warming up, or fewer than 10 pixels in a region): not filtered.", clips.join("; "), r.max_gap_s, r.min_frames, r.min_visibility))
-            .with_note("Features: the mean colour of fig. 4a's three regions, split on the blob's height, of the person's pixels — the local tracker's own foreground inside the box (`paper`; `ceiling: exact masks` = the synthesizer's per-person mask; `whole box` = every pixel of the box, the feature before issue 31) — in the colour-channel-normalised space of the paper's [8] (each channel / its frame mean; `ln space` = its log, `raw RGB` = RGB / 255), averaged over the track's frames.")
+            .with_note("Features: the mean colour of fig. 4a's three regions, split on the blob's height, of the person's pixels — the local tracker's own foreground inside the box (`paper`; `ceiling: exact masks` = the synthesizer's per-person mask; `whole box` = every pixel of the box, the feature before issue 31; `filled silhouettes` = the foreground with each row filled between its first and last pixel) — in the colour-channel-normalised space of the paper's [8] (each channel / its frame mean; `ln space` = its log, `raw RGB` = RGB / 255, `chromaticity` = each region's normalised colour / its r + g + b, [8]'s second step), averaged over the track's frames.")
             .with_note(format!("Prior as printed: a₀ = 0, κ₀ = 100, η₀ = 9, C₀ = 10⁻³·I; `prior moved` = a₀, κ₀ and C₀ fitted on the training split (table reid_prior; our addition). P_δ = 0 when a track starts before the person's previous one ended. Nearest neighbour: threshold {} (a priori) or fitted on the training split, with the same no-overlap rule. misidentified = observations not on their person under the best one-to-one label mapping; people_error = found − true; wrongly_new = people with an observation labelled as nobody's (a new individual); merged = people with an observation labelled as another person; people_wrong = either.", r.nn_threshold)),
     );
     products.tables.push(
@@ -333,6 +333,7 @@ pub(super) fn products(
 mod tests {
     use super::*;
     use crate::pipelines::s003_zivkovic_background::reid_features::{PixelSet, Space};
+    use crate::pipelines::s003_zivkovic_background::reid_methods::{Model, PriorKind};
     use crate::track::reid::Span;
 
     const F: Feature = (PixelSet::Person, Space::Normalised);
@@ -389,9 +390,26 @@ mod tests {
             .collect();
         let training = Training::fit(&[("t_90".into(), train)]).expect("fit");
         let got = runs(&scored, &p, &training).expect("runs");
-        // one row per method, but for the exact masks with the moved prior: the training
-        // split has no exact-mask looks to move it with
-        assert_eq!(got.rows.len(), METHODS.len() - 1);
+        // one row per method, but for the moved prior on any feature other than the person's
+        // channel-normalised pixels: the training split has no such looks to move it with
+        let unfitted = METHODS
+            .iter()
+            .filter(|m| {
+                m.feature != F
+                    && matches!(
+                        m.model,
+                        Model::Adf {
+                            prior: PriorKind::Trained,
+                            ..
+                        }
+                    )
+            })
+            .count();
+        assert_eq!(
+            unfitted, 4,
+            "exact, filled, chromaticity, exact chromaticity"
+        );
+        assert_eq!(got.rows.len(), METHODS.len() - unfitted);
         assert!(!got.rows.iter().any(|r| r.method == METHODS[8].name));
         let row = |name: &str| got.rows.iter().find(|r| r.method == name).expect(name);
         let paper = row(PAPER_NAME);
@@ -408,7 +426,7 @@ mod tests {
         let exact = row("ceiling: exact masks");
         assert_eq!((exact.observations, exact.no_feature), (0, 4));
         // the per-observation table holds every observation of every run, labelled or not
-        assert_eq!(got.observations.len(), 4 * (METHODS.len() - 1));
+        assert_eq!(got.observations.len(), 4 * (METHODS.len() - unfitted));
         let labelled = got
             .observations
             .iter()
@@ -418,7 +436,8 @@ mod tests {
         assert_eq!(labelled, 4 * with_feature);
         // without a training split the fitted rows are left out
         let none = runs(&scored, &p, &Training::default()).expect("runs");
-        assert_eq!(none.rows.len(), METHODS.len() - 3);
+        // (every moved prior and the fitted nearest-neighbour threshold)
+        assert_eq!(none.rows.len(), METHODS.len() - unfitted - 2);
     }
 
     const PAPER_NAME: &str = "paper (ADF)";
