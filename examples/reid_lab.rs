@@ -27,8 +27,14 @@ fn main() -> anyhow::Result<()> {
     let text = std::fs::read_to_string(&path)?;
     // (split, session, clip) -> observations in order
     let mut groups: BTreeMap<(String, String, String), Vec<(i64, Obs)>> = BTreeMap::new();
-    for line in text.lines().skip(1) {
+    for (n, line) in text.lines().enumerate().skip(1) {
         let c: Vec<&str> = line.split(',').collect();
+        anyhow::ensure!(
+            c.len() == 16,
+            "{path}:{}: {} fields, want 16 (split,session,clip,order,truth,enter,leave,f1..f9)",
+            n + 1,
+            c.len()
+        );
         let f: Vec<f64> = c[7..16]
             .iter()
             .map(|v| v.parse())
