@@ -58,7 +58,7 @@ use crate::track::pdaf::{AssociationKind, FilterError, FilterParams, ModelKind, 
 use crate::vision::cylinder::{self, CorrForm, CylinderMap};
 
 pub mod others;
-use others::{Others, OthersParams, Shared};
+use others::{BlobColour, Others, OthersParams, Shared};
 
 /// The default floor on the normalised correlation (a correlation coefficient, ≤ 1) with the
 /// template for re-acquisition after `rst`: see `FollowParams::default`.
@@ -612,14 +612,21 @@ impl FollowTracker {
                 if let Some(j) = taken {
                     o.forget_near(z[j], &shared);
                 }
-                o.update(obs.t, &z, taken, &shared);
+                o.update(obs.t, &z, &hists, taken, &shared);
             }
             return Ok(out);
         };
         filter.predict(obs.t)?;
+        let (form, corr_min) = (self.params.corr_form, self.params.corr_min);
+        let lr_of =
+            move |h: &[f64], t: &[f64]| cylinder::likelihood_ratio(form.corr(h, t), corr_min);
+        let colour = BlobColour {
+            hists: &hists,
+            lr: &lr_of,
+        };
         let a = match self.others.as_ref() {
             Some(o) => {
-                let f = o.discount(&z, &shared);
+                let f = o.discount(&z, &colour, &shared);
                 let lr_others: Vec<f64> = lr.iter().zip(&f).map(|(l, f)| l * f).collect();
                 filter.update(&z, &lr_others)?
             }
@@ -627,7 +634,7 @@ impl FollowTracker {
         };
         if let Some(o) = self.others.as_mut() {
             let taken = a.chosen.filter(|&j| a.beta[j] > a.beta0);
-            o.update(obs.t, &z, taken, &shared);
+            o.update(obs.t, &z, &hists, taken, &shared);
             o.coalesce(filter.position(), filter.position_covariance());
         }
         out.gated = a.gated.len();

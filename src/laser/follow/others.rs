@@ -31,8 +31,17 @@
 //! Only confirmed tracks discount. Static clutter (tree trunks) becomes tracks too, which is
 //! what it is: something that is not the target. When the target is (re-)initialised on a
 //! blob, the track that blob belongs to is deleted ([`Others::forget_near`]). Values are a
-//! priori (`OthersParams::default`). What it does not do: no track of the target's identity
-//! among the others, no colour on the other tracks, no joint update of the other tracks.
+//! priori (`OthersParams::default`).
+//!
+//! **Colour on the other tracks** (`OthersParams::colour`, round 6 of issue 30): each track
+//! holds the hue–saturation histogram of its first blob that had one as its template, and its
+//! pair weights become `w_ok = P_D · N(z_k; ẑ_o, S_o) · lr_ok`, with `lr_ok` the same
+//! likelihood ratio of blob `k` against track `o`'s template as the target's (`lr = 1` where
+//! a histogram or the template is missing). That is the JPDA with every track's own colour
+//! likelihood against uniform clutter, the algebra above unchanged. Without it a companion's
+//! track that drifts next to the target discounts the target's own blob whatever its colour
+//! (round 5's "other" resets). What it does not do: no track of the target's identity among
+//! the others, no joint update of the other tracks.
 
 use nalgebra::{Matrix2, SMatrix, Vector2, Vector4};
 
@@ -54,6 +63,9 @@ pub struct OthersParams {
     /// A track whose position lies within this squared Mahalanobis distance of the target's
     /// (under the sum of both position covariances) is the target itself and is deleted.
     pub coalesce_d2: f64,
+    /// Each track's colour likelihood in its pair weights (module doc); false: position only
+    /// (round 5).
+    pub colour: bool,
 }
 
 impl Default for OthersParams {
@@ -61,7 +73,8 @@ impl Default for OthersParams {
     /// speed), move at up to ~3 m/s from rest (speed sd 1.5 m/s at birth), are believed after
     /// three scans in a row (0.3 s at 10 Hz) and forgotten after 1 s without a blob; a track
     /// within one standard deviation of the target (d² ≤ 1, about 0.2 m for settled tracks,
-    /// closer than two people's centres can be) is the target.
+    /// closer than two people's centres can be) is the target; every track weighs blobs by
+    /// its own colour as the target does.
     fn default() -> Self {
         OthersParams {
             accel_sigma: 2.0,
@@ -69,6 +82,7 @@ impl Default for OthersParams {
             confirm_hits: 3,
             max_coast_s: 1.0,
             coalesce_d2: 1.0,
+            colour: true,
         }
     }
 }
@@ -95,6 +109,8 @@ struct Track {
     kf: Kalman<4>,
     hits: usize,
     last_hit: f64,
+    /// The histogram of the track's first blob that had one (`OthersParams::colour`).
+    template: Option<Vec<f64>>,
 }
 
 impl Track {
@@ -113,6 +129,25 @@ impl Track {
         }
         let nu = Vector2::new(z[0] - self.kf.x[0], z[1] - self.kf.x[1]);
         Some(((nu.transpose() * inv * nu)[(0, 0)], det))
+    }
+}
+
+/// What colour says about one scan's blobs, for the other tracks.
+pub struct BlobColour<'a> {
+    /// Each blob's histogram (`None`: no image or no region).
+    pub hists: &'a [Option<Vec<f64>>],
+    /// The likelihood ratio of a histogram (first) against a template (second), the
+    /// target's own form.
+    pub lr: &'a dyn Fn(&[f64], &[f64]) -> f64,
+}
+
+impl BlobColour<'_> {
+    /// No colour: every ratio 1.
+    pub fn none() -> BlobColour<'static> {
+        BlobColour {
+            hists: &[],
+            lr: &|_, _| 1.0,
+        }
     }
 }
 
@@ -156,15 +191,20 @@ impl Others {
         }
     }
 
-    /// The factor `f_j` of the module doc for every blob `z` (after [`Self::predict`]).
-    pub fn discount(&self, z: &[[f64; 2]], sh: &Shared) -> Vec<f64> {
+    /// The factor `f_j` of the module doc for every blob `z` (after [`Self::predict`]);
+    /// `seen` gives each blob's histogram and the likelihood ratio of a histogram against a
+    /// template (used when `OthersParams::colour` is on).
+    pub fn discount(&self, z: &[[f64; 2]], seen: &BlobColour<'_>, sh: &Shared) -> Vec<f64> {
         let miss = sh.clutter_density * (1.0 - sh.p_d * sh.p_g()).max(0.0);
         let mut f = vec![1.0; z.len()];
         for tr in self.tracks.iter().filter(|t| t.confirmed(&self.params)) {
             let w: Vec<f64> = z
                 .iter()
-                .map(|&zj| match tr.innovation(zj, sh.sigma_r) {
-                    Some((d2, det)) if d2 <= sh.gate => sh.p_d * gaussian_2d(d2, det),
+                .enumerate()
+                .map(|(j, &zj)| match tr.innovation(zj, sh.sigma_r) {
+                    Some((d2, det)) if d2 <= sh.gate => {
+                        sh.p_d * gaussian_2d(d2, det) * self.colour_lr(tr, seen, j)
+                    }
                     _ => 0.0,
                 })
                 .collect();
@@ -179,10 +219,34 @@ impl Others {
         f
     }
 
+    /// Track `tr`'s colour likelihood ratio for blob `j` (1 with colour off, without a
+    /// template or without the blob's histogram).
+    fn colour_lr(&self, tr: &Track, seen: &BlobColour<'_>, j: usize) -> f64 {
+        if !self.params.colour {
+            return 1.0;
+        }
+        match (
+            tr.template.as_deref(),
+            seen.hists.get(j).and_then(Option::as_deref),
+        ) {
+            (Some(t), Some(h)) => (seen.lr)(h, t),
+            _ => 1.0,
+        }
+    }
+
     /// Assigns the blobs other than `taken` (the target's) to the tracks, starts tracks on
     /// the blobs left over and deletes those without a hit for `max_coast_s` (see the module
-    /// doc). Call after [`Self::predict`] to the scan's time `t`.
-    pub fn update(&mut self, t: f64, z: &[[f64; 2]], taken: Option<usize>, sh: &Shared) {
+    /// doc); a track without a template takes its blob's histogram. Call after
+    /// [`Self::predict`] to the scan's time `t`.
+    pub fn update(
+        &mut self,
+        t: f64,
+        z: &[[f64; 2]],
+        hists: &[Option<Vec<f64>>],
+        taken: Option<usize>,
+        sh: &Shared,
+    ) {
+        let hist = |j: usize| hists.get(j).cloned().flatten();
         let free: Vec<usize> = (0..z.len()).filter(|&j| Some(j) != taken).collect();
         let tracks = &self.tracks;
         let pairs = assign::min_cost_max_pairs(tracks.len(), free.len(), |i, k| {
@@ -201,6 +265,9 @@ impl Others {
                 tr.hits += 1;
                 tr.last_hit = t;
                 used[k] = true;
+                if tr.template.is_none() {
+                    tr.template = hist(free[k]);
+                }
             }
         }
         let max_coast = self.params.max_coast_s;
@@ -221,6 +288,7 @@ impl Others {
                 kf: Kalman::new(Vector4::new(zj[0], zj[1], 0.0, 0.0), p),
                 hits: 1,
                 last_hit: t,
+                template: hist(j),
             });
         }
     }
