@@ -293,6 +293,7 @@ mod tests {
             ground: false,
             occluded: false,
             out_of_view,
+            obstacle: false,
         }
     }
 

@@ -26,6 +26,10 @@ use crate::table_row;
 /// before and after its start.
 pub const LOSS_WINDOW_S: f64 = 1.0;
 
+/// A loss no other cause explains is put on a static obstacle when one hid the person on at
+/// least this share of the second before (the rst causes' 30 %).
+pub const OBSTACLE_SHARE: f64 = 0.3;
+
 table_row! {
     /// One method's first loss of the person in one run: `losses`.
     #[derive(Debug, Clone, PartialEq)]
@@ -41,10 +45,11 @@ table_row! {
         /// scans nearest the other person, for a capture).
         pub corr_median: Option<f64>,
         /// Shares of the window before the loss with the person occluded, behind a ground
-        /// hit, out of the laser's view.
+        /// hit, out of the laser's view, behind a static obstacle.
         pub occluded: f64,
         pub ground: f64,
         pub out_of_view: f64,
+        pub obstacle: f64,
         /// `rst` (any cause) in the window after the loss's start.
         pub rst: bool,
     }
@@ -95,15 +100,6 @@ pub fn first_loss(
             .filter_map(|r| r.corr)
             .collect(),
     );
-    let cause = if after.last()?.x.is_none() && other.is_none() {
-        "no estimate"
-    } else if other.is_some() && corr_median.is_some_and(|c| c >= p.follower.reacquire_corr) {
-        "other person, colour alike"
-    } else if other.is_some() {
-        "other person, other colour"
-    } else {
-        "clutter"
-    };
     let (t0, t1) = (rows[i].t_s - LOSS_WINDOW_S, rows[i].t_s);
     let before: Vec<&TruthRow> = truth
         .iter()
@@ -116,6 +112,17 @@ pub fn first_loss(
             before.iter().filter(|t| f(t)).count() as f64 / before.len() as f64
         }
     };
+    let cause = if after.last()?.x.is_none() && other.is_none() {
+        "no estimate"
+    } else if other.is_some() && corr_median.is_some_and(|c| c >= p.follower.reacquire_corr) {
+        "other person, colour alike"
+    } else if other.is_some() {
+        "other person, other colour"
+    } else if share(|t| t.obstacle) >= OBSTACLE_SHARE {
+        "obstacle in the way"
+    } else {
+        "clutter"
+    };
     Some(LossRow {
         run: run.into(),
         method: method.into(),
@@ -126,6 +133,7 @@ pub fn first_loss(
         occluded: share(|t| t.occluded),
         ground: share(|t| t.ground),
         out_of_view: share(|t| t.out_of_view),
+        obstacle: share(|t| t.obstacle),
         rst: after.iter().any(|r| r.reset),
     })
 }
@@ -149,12 +157,23 @@ pub fn table(data: &[&SessionData], p: &Params) -> anyhow::Result<Table> {
         "How each replayed method first loses the person, per run (error analysis)",
         LossRow::frame(&rows(data, p))?,
     );
-    for c in ["t_s", "corr_median", "occluded", "ground", "out_of_view"] {
+    for c in [
+        "t_s",
+        "corr_median",
+        "occluded",
+        "ground",
+        "out_of_view",
+        "obstacle",
+    ] {
         t = t.with_precision(c, 2);
     }
     Ok(t.with_note(format!(
-        "A loss starts at the first scan from which the estimate stays farther than {} m from the person (or is absent) for {} s. cause: other person when the estimate was nearest another person most often in the second after and within {} m of them in the second either side (colour alike when the median normalised correlation of the blobs taken on those scans reaches {}, the re-acquisition floor, else other colour); no estimate (dropped, not re-acquired at the end); clutter otherwise. occluded / ground / out_of_view: shares of the second before. The paper's configuration's replay follows the closed loop until the loop loses the person; later losses of other methods may follow from where the loop drove the robot.",
-        p.followed_within_m, LOSS_WINDOW_S, p.followed_within_m, p.follower.reacquire_corr
+        "A loss starts at the first scan from which the estimate stays farther than {} m from the person (or is absent) for {} s. cause: other person when the estimate was nearest another person most often in the second after and within {} m of them in the second either side (colour alike when the median normalised correlation of the blobs taken on those scans reaches {}, the re-acquisition floor, else other colour); no estimate (dropped, not re-acquired at the end); obstacle in the way when a static obstacle hid the person on at least {} of the second before (truth.obstacle: the scan short of the person on every beam towards them, neither ground nor a person explaining it); clutter otherwise. occluded / ground / out_of_view / obstacle: shares of the second before. The paper's configuration's replay follows the closed loop until the loop loses the person; later losses of other methods may follow from where the loop drove the robot.",
+        p.followed_within_m,
+        LOSS_WINDOW_S,
+        p.followed_within_m,
+        p.follower.reacquire_corr,
+        OBSTACLE_SHARE
     )))
 }
 

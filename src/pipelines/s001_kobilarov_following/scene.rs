@@ -1,8 +1,10 @@
 //! What the ground truth says about a scan: where the laser's beam towards the target meets
 //! the ground (the paper's "gnd": a balancing robot that pitches forward sees the ground
 //! between itself and the person), whether another person stands in the line of sight (the
-//! paper's "x"), and whether the target is outside the laser's field of view or range.
-//! Pure geometry on the true poses.
+//! paper's "x"), whether the target is outside the laser's field of view or range — pure
+//! geometry on the true poses — and whether the scan itself returns short of the target on
+//! every beam towards it ([`short_of`]: something stands in the way, a tree or a bush
+//! included, which the people's ground truth does not list).
 
 use nalgebra::{Isometry3, Point2, Point3, Vector3};
 
@@ -47,6 +49,48 @@ pub fn view(
         along > 0.0 && along < dist && across < p.radius + margin_m
     });
     (ground, occluded, out_of_view)
+}
+
+/// A scan's beams: the first beam's angle, the step (rad), the ranges (m; NaN, ±inf and 0:
+/// no return).
+#[derive(Debug, Clone, Copy)]
+pub struct Beams<'a> {
+    pub angle_min: f64,
+    pub increment: f64,
+    pub ranges: &'a [f32],
+}
+
+/// Whether every beam of the scan towards the target's body (bearings within
+/// asin(radius / distance) of its centre, seen from the laser) returns more than `margin_m`
+/// short of the body's near side: something stands between laser and target. `false` when no
+/// beam points at the target (out of the scan) or any such beam has no return or reaches it.
+pub fn short_of(
+    map_from_laser: &Isometry3<f64>,
+    target: &PersonTruth,
+    beams: Beams<'_>,
+    margin_m: f64,
+) -> bool {
+    let local = map_from_laser.inverse() * Point3::new(target.x, target.y, 0.0);
+    let dist = local.x.hypot(local.y);
+    if !(dist > target.radius && beams.increment > 0.0) {
+        return false;
+    }
+    let bearing = local.y.atan2(local.x);
+    let half = (target.radius / dist).min(1.0).asin();
+    let first = ((bearing - half - beams.angle_min) / beams.increment).ceil();
+    let last = ((bearing + half - beams.angle_min) / beams.increment).floor();
+    if !(first.is_finite() && last.is_finite()) || last < 0.0 || first > last {
+        return false;
+    }
+    let n = beams.ranges.len() as f64;
+    if first >= n {
+        return false;
+    }
+    let limit = dist - target.radius - margin_m;
+    (first.max(0.0) as usize..=(last.min(n - 1.0) as usize)).all(|i| {
+        let r = f64::from(beams.ranges[i]);
+        r.is_finite() && r > 0.0 && r < limit
+    })
 }
 
 /// Yaw and pitch (positive nose down, REP 103) of a pose.
@@ -114,6 +158,41 @@ mod tests {
         assert!(!view(&pose, &t, &[&aside, &behind], 1.6, 20.0, 0.1).1);
         // behind the laser: out of its 180° view
         assert!(view(&pose, &person(1, -3.0, 0.0), &[], 1.6, 20.0, 0.1).2);
+    }
+
+    /// A level laser at the origin, beams every 0.5° from −90°: a target 4 m ahead (radius
+    /// 0.2 m) spans the beams within asin(0.05) = 2.87° of 0°, i.e. 175..=185 (beam 180 at 0°).
+    #[test]
+    fn a_scan_short_of_the_target_on_every_beam_towards_it() {
+        let pose = Isometry3::translation(0.0, 0.0, 0.45);
+        let t = person(1, 4.0, 0.0);
+        fn beams(r: &[f32]) -> Beams<'_> {
+            Beams {
+                angle_min: -std::f64::consts::FRAC_PI_2,
+                increment: 0.5f64.to_radians(),
+                ranges: r,
+            }
+        }
+        let mut r = vec![f32::INFINITY; 361];
+        r[174] = 5.0; // just outside the body's beams (a return beyond it): not looked at
+        r[186] = 5.0;
+        for x in &mut r[175..=185] {
+            *x = 3.79; // the body's near side 3.8 m: the target itself
+        }
+        assert!(!short_of(&pose, &t, beams(&r), 0.1));
+        for x in &mut r[175..=185] {
+            *x = 2.0; // a bush at 2 m covering the whole body
+        }
+        assert!(short_of(&pose, &t, beams(&r), 0.1));
+        r[175] = 3.79; // one edge beam reaches the body: not hidden
+        assert!(!short_of(&pose, &t, beams(&r), 0.1));
+        r[175] = 2.0;
+        r[185] = f32::INFINITY; // a beam without a return: not evidence of an obstacle
+        assert!(!short_of(&pose, &t, beams(&r), 0.1));
+        r[185] = 3.65; // 0.15 m short of the near side, beyond the 0.1 m margin
+        assert!(short_of(&pose, &t, beams(&r), 0.1));
+        // behind the scan (no beam points there)
+        assert!(!short_of(&pose, &person(1, -4.0, 0.0), beams(&r), 0.1));
     }
 
     #[test]

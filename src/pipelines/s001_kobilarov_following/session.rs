@@ -411,7 +411,7 @@ fn truth_at(
     *prev = Some((t, x, y));
     let frame = ctx.gt.nearest(f.stamp, ctx.tolerance_ns);
     let target = frame.and_then(|fr| fr.people.iter().find(|q| q.id == ctx.p.target_id));
-    let (mut ground, mut occluded, mut out_of_view) = (false, false, true);
+    let (mut ground, mut occluded, mut out_of_view, mut obstacle) = (false, false, true, false);
     if let (Some(tg), Some(fr)) = (target, frame) {
         let others: Vec<_> = fr.people.iter().filter(|q| q.id != tg.id).collect();
         let fov = 0.5 * (f64::from(f.scan.angle_max) - f64::from(f.scan.angle_min)).abs();
@@ -423,6 +423,15 @@ fn truth_at(
             f64::from(f.scan.range_max),
             ctx.p.occlusion_margin_m,
         );
+        let beams = scene::Beams {
+            angle_min: f64::from(f.scan.angle_min),
+            increment: f64::from(f.scan.angle_increment),
+            ranges: &f.scan.ranges,
+        };
+        obstacle = !ground
+            && !occluded
+            && !out_of_view
+            && scene::short_of(&laser, tg, beams, ctx.p.occlusion_margin_m);
     }
     let rb = target.map(|tg| scene::range_bearing(x, y, yaw, (tg.x, tg.y)));
     Some(TruthRow {
@@ -442,5 +451,6 @@ fn truth_at(
         ground,
         occluded,
         out_of_view,
+        obstacle,
     })
 }

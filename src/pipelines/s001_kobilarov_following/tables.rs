@@ -104,6 +104,10 @@ table_row! {
         pub occluded: bool,
         /// The target lies outside the laser's field of view or range.
         pub out_of_view: bool,
+        /// The scan returns short of the target on every beam towards it and neither the
+        /// ground nor another person explains it: a static obstacle (tree, bush) in the way
+        /// ([`super::scene::short_of`]).
+        pub obstacle: bool,
     }
 }
 

@@ -59,6 +59,7 @@ fn truth_row(k: usize) -> TruthRow {
         ground: false,
         occluded: false,
         out_of_view: false,
+        obstacle: false,
     }
 }
 
@@ -90,6 +91,25 @@ fn alike_colour_no_estimate_and_clutter() {
     // nearest is the target itself (coasting off it): clutter
     let drift = loss(&run(20, 1, Some(0.0), true), &truth(40)).expect("drift");
     assert_eq!(drift.cause, "clutter");
+    // the same drift with a tree in the way on 3 of the 10 scans before: the obstacle
+    let tree: Vec<TruthRow> = (0..40)
+        .map(|k| TruthRow {
+            obstacle: (17..20).contains(&k),
+            ..truth_row(k)
+        })
+        .collect();
+    let hidden = loss(&run(20, 1, Some(0.0), true), &tree).expect("hidden");
+    assert_eq!(hidden.cause, "obstacle in the way");
+    assert!((hidden.obstacle - 0.3).abs() < 1e-9, "{hidden:?}");
+    // on 2 of 10 only: below the share, clutter
+    let brief: Vec<TruthRow> = (0..40)
+        .map(|k| TruthRow {
+            obstacle: (18..20).contains(&k),
+            ..truth_row(k)
+        })
+        .collect();
+    let l = loss(&run(20, 1, Some(0.0), true), &brief).expect("brief");
+    assert_eq!(l.cause, "clutter");
 }
 
 /// Off the person for 0.9 s (9 scans) and back: no loss; never off: no loss.
