@@ -27,6 +27,16 @@ fn track(x: f64, y: f64, var: f64) -> Track {
     }
 }
 
+/// Blobs of the JPDA tests: the target's, one between the target and the first other track,
+/// that track's own, one near the second other track, one far from everyone.
+const BLOBS: [[f64; 2]; 5] = [
+    [0.0, 0.0],
+    [0.7, 0.1],
+    [1.25, 0.15],
+    [-0.8, 0.3],
+    [5.0, 5.0],
+];
+
 /// The JPDA weights `P_D N(z; ẑ, S)` of a position with covariance `s` (gated) for `z`.
 fn weights(mean: [f64; 2], s: Matrix2<f64>, z: &[[f64; 2]], sh: &Shared, lr: &[f64]) -> Vec<f64> {
     let inv = s.try_inverse().expect("positive definite");
@@ -54,15 +64,7 @@ fn discounted_pdaf_is_the_jpda_marginal_of_the_target() {
         tracks: vec![track(1.3, 0.1, 0.02), track(-1.0, 0.4, 0.05)],
         t: Some(0.0),
     };
-    // blobs: the target's, one between target and other 0, other 0's own, one near other 1,
-    // one far from everyone
-    let z = [
-        [0.0, 0.0],
-        [0.7, 0.1],
-        [1.25, 0.15],
-        [-0.8, 0.3],
-        [5.0, 5.0],
-    ];
+    let z = BLOBS;
     let lr = [0.9, 0.3, 0.1, 0.6, 1.0];
     let s_t = Matrix2::new(0.12, 0.02, 0.02, 0.09);
     let w_t = weights([0.1, 0.05], s_t, &z, &sh, &lr);
@@ -182,13 +184,7 @@ fn colour_on_the_other_tracks_is_the_jpda_with_their_colour() {
         tracks: vec![red, track(-1.0, 0.4, 0.05)],
         t: Some(0.0),
     };
-    let z = [
-        [0.0, 0.0],
-        [0.7, 0.1],
-        [1.25, 0.15],
-        [-0.8, 0.3],
-        [5.0, 5.0],
-    ];
+    let z = BLOBS;
     let hists = [
         Some(vec![0.0, 1.0]),
         Some(vec![1.0, 0.0]),

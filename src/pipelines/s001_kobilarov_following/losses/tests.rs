@@ -63,6 +63,16 @@ fn truth_row(k: usize) -> TruthRow {
     }
 }
 
+/// 40 scans with a static obstacle hiding the person on the scans in `hidden`.
+fn obstacle_on(hidden: std::ops::Range<usize>) -> Vec<TruthRow> {
+    (0..40)
+        .map(|k| TruthRow {
+            obstacle: hidden.contains(&k),
+            ..truth_row(k)
+        })
+        .collect()
+}
+
 fn loss(rows: &[TrackRow], truth: &[TruthRow]) -> Option<LossRow> {
     let r: Vec<&TrackRow> = rows.iter().collect();
     first_loss("run", "ct_colour", &r, truth, &Params::default())
@@ -92,22 +102,12 @@ fn alike_colour_no_estimate_and_clutter() {
     let drift = loss(&run(20, 1, Some(0.0), true), &truth(40)).expect("drift");
     assert_eq!(drift.cause, "clutter");
     // the same drift with a tree in the way on 3 of the 10 scans before: the obstacle
-    let tree: Vec<TruthRow> = (0..40)
-        .map(|k| TruthRow {
-            obstacle: (17..20).contains(&k),
-            ..truth_row(k)
-        })
-        .collect();
+    let tree = obstacle_on(17..20);
     let hidden = loss(&run(20, 1, Some(0.0), true), &tree).expect("hidden");
     assert_eq!(hidden.cause, "obstacle in the way");
     assert!((hidden.obstacle - 0.3).abs() < 1e-9, "{hidden:?}");
     // on 2 of 10 only: below the share, clutter
-    let brief: Vec<TruthRow> = (0..40)
-        .map(|k| TruthRow {
-            obstacle: (18..20).contains(&k),
-            ..truth_row(k)
-        })
-        .collect();
+    let brief = obstacle_on(18..20);
     let l = loss(&run(20, 1, Some(0.0), true), &brief).expect("brief");
     assert_eq!(l.cause, "clutter");
 }
