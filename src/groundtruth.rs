@@ -46,6 +46,14 @@ pub struct FollowerState {
     /// (absent otherwise, and in logs written before it existed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub look_at: Option<[f64; 2]>,
+    /// The platform's obstacle check changed the controller's command (absent: it did not,
+    /// or the log predates the check).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub avoided: bool,
+    /// The robot's footprint touched an obstacle since the previous scan (a bumper's report;
+    /// absent: it did not, or the log predates the footprint).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub contact: bool,
 }
 
 /// What one camera sees of one person.

@@ -342,6 +342,7 @@ mod tests {
                 max_turn_rate: 1.5,
                 estimator: Default::default(),
                 pdaf: Default::default(),
+                platform: Default::default(),
             }),
             tour: None,
             odom_noise: [0.0, 0.0],

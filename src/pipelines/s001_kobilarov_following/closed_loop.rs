@@ -53,6 +53,8 @@ pub fn rows(
             cmd_v: st.command_v,
             cmd_w: st.command_w,
             desired_m: st.desired_distance,
+            avoided: st.avoided,
+            contact: st.contact,
         });
     }
     Ok(out)

@@ -43,7 +43,8 @@ pub struct KobilarovFollowing;
 
 impl Experiment for KobilarovFollowing {
     const KIND: &'static str = "s001_kobilarov_following";
-    const VERSION: u32 = 7; // 5: ct_colour_others (the other people tracked) and loop_method;
+    const VERSION: u32 = 8; // 8: the platform (avoided, contact; Table I contacts);
+    // 7: // 5: ct_colour_others (the other people tracked) and loop_method;
     // 6: the other tracks weigh blobs by their own colour; 7: `obstacle` (truth, rst causes,
     // losses)
     const SESSION_TABLES: &'static [crate::run::schemas::TableDoc] = tables::SESSION_TABLES;

@@ -4,7 +4,10 @@
 //! - **Table I** per run (session): r_avg (mean range to the person), b_avg (mean absolute
 //!   bearing, rad), v_avg (mean robot speed), err_avg (mean |E_follow|, E_follow = r − d_follow
 //!   − v²/(2 a_min)), v_max, over every scan where the person exists; then the mean and std rows
-//!   over the runs, as printed; the paper's twelve rows beside them.
+//!   over the runs, as printed; the paper's twelve rows beside them. Beside each of our runs the
+//!   platform's record from `/follower/state`: contacts with obstacles ([`contacts`]) and the
+//!   share of commands the obstacle check changed (`synth::follow::avoid`; the paper says
+//!   nothing of either, so its rows leave them empty).
 //! - **`rst` events**: every scan where the robot's own tracker dropped its track. Cause, from
 //!   the ground truth of the scans since the tracker last accepted a measurement (the replay of
 //!   the paper's configuration, which reproduces the loop, says when: `gated > 0`; at most 3 s
@@ -66,6 +69,10 @@ table_row! {
         pub on_person: Option<f64>,
         pub end_range_m: Option<f64>,
         pub followed: Option<String>,
+        /// The platform (`synth::follow::avoid`): contacts with obstacles (scans reporting one
+        /// after one that did not) and the share of commands the obstacle check changed.
+        pub contacts: Option<i64>,
+        pub avoided_share: Option<f64>,
     }
 }
 
@@ -166,6 +173,8 @@ fn row(
         on_person: None,
         end_range_m: None,
         followed: None,
+        contacts: None,
+        avoided_share: None,
         source: source.into(),
         run: run.into(),
         controller: controller.into(),
@@ -176,6 +185,21 @@ fn row(
         err_avg: v.map(|v| v[3]),
         v_max: v.map(|v| v[4]),
     }
+}
+
+/// Contacts in a run: scans reporting one after a scan that did not.
+pub fn contacts(rows: &[LoopRow]) -> i64 {
+    let mut before = false;
+    let mut n = 0;
+    for r in rows {
+        n += i64::from(r.contact && !before);
+        before = r.contact;
+    }
+    n
+}
+
+fn share(rows: &[LoopRow], f: fn(&LoopRow) -> bool) -> Option<f64> {
+    (!rows.is_empty()).then(|| rows.iter().filter(|r| f(r)).count() as f64 / rows.len() as f64)
 }
 
 /// Table I: ours per run, mean and std, then the paper's.
@@ -192,6 +216,8 @@ pub fn table1_rows(data: &[&SessionData], p: &Params) -> Vec<Table1Row> {
             on_person: f.map(|f| f.0),
             end_range_m: f.map(|f| f.1),
             followed: f.map(|f| if f.2 { "yes" } else { "no" }.to_string()),
+            contacts: (!d.closed_loop.is_empty()).then(|| contacts(&d.closed_loop)),
+            avoided_share: share(&d.closed_loop, |r| r.avoided),
             ..row("ours", &d.name, controller, dur, v)
         });
     }
@@ -392,6 +418,15 @@ pub fn summary(data: &[&SessionData], p: &Params) -> Vec<String> {
             m.followed.as_deref().unwrap_or("-")
         ));
     }
+    let n_contacts: i64 = data.iter().map(|d| contacts(&d.closed_loop)).sum();
+    let loops: Vec<&LoopRow> = data.iter().flat_map(|d| &d.closed_loop).collect();
+    if !loops.is_empty() {
+        let avoided = loops.iter().filter(|r| r.avoided).count() as f64 / loops.len() as f64;
+        out.push(format!(
+            "platform: {n_contacts} contacts with obstacles; the obstacle check changed {:.1} % of the commands",
+            100.0 * avoided
+        ));
+    }
     let ev: Vec<RstRow> = data.iter().flat_map(|d| events(d, p)).collect();
     let s = summary_row("ours", "all", &ev);
     out.push(format!(
@@ -399,4 +434,34 @@ pub fn summary(data: &[&SessionData], p: &Params) -> Vec<String> {
         s.rst, s.reacquired_right, s.ground, s.occlusion, s.obstacle, s.out_of_view, s.other
     ));
     out
+}
+
+#[cfg(test)]
+mod platform_tests {
+    use super::*;
+
+    #[test]
+    fn contacts_count_the_onsets_not_the_scans() {
+        let row = |contact: bool| LoopRow {
+            t_s: 0.0,
+            x: None,
+            y: None,
+            vx: None,
+            vy: None,
+            cov_norm: None,
+            reset: false,
+            controller: "direct".into(),
+            cmd_v: 0.0,
+            cmd_w: 0.0,
+            desired_m: 3.2,
+            avoided: !contact,
+            contact,
+        };
+        let rows: Vec<LoopRow> = [true, true, false, false, true, false, true, true]
+            .map(row)
+            .to_vec();
+        assert_eq!(contacts(&rows), 3);
+        assert_eq!(share(&rows, |r| r.avoided), Some(3.0 / 8.0));
+        assert_eq!(share(&[], |r| r.avoided), None);
+    }
 }

@@ -127,6 +127,10 @@ table_row! {
         pub cmd_v: f64,
         pub cmd_w: f64,
         pub desired_m: f64,
+        /// The platform's obstacle check changed the command (`synth::follow::avoid`).
+        pub avoided: bool,
+        /// The footprint touched an obstacle since the previous scan (a bumper's report).
+        pub contact: bool,
     }
 }
 

@@ -4,7 +4,10 @@
 //! the follower's laser (and, when the follower reads it, of the omni camera) the sensor
 //! captured through [`Sensors`] at the robot's current true pose. The follower's output at a
 //! scan sets the command until the next scan; the robot tracks the commanded speed within
-//! its acceleration and deceleration (`a_min`) limits.
+//! its acceleration and deceleration (`a_min`) limits. Under the controllers sits the platform
+//! ([`avoid`](super::avoid)): each command is checked against the scan, and a step that would
+//! put the footprint inside an obstacle is not taken (the robot stops there; the next scan's
+//! record says so, as a bumper would).
 //!
 //! Timing: a capture at `t` is processed once the track holds the samples on both sides of
 //! `t` ([`RobotTrack::holds`]), so the true pose it sees is exactly what the finished track
@@ -15,6 +18,7 @@ use image::RgbImage;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use rand_distr::{Distribution, Normal};
 
+use super::avoid;
 use super::controller::{self, Command, Limits, OdomPose, Trail};
 use super::{Follower, FollowerOutput, OmniInput, ScanInput};
 use crate::geometry::camera::CameraModel;
@@ -25,6 +29,7 @@ use crate::synth::robot::{
     self, Odometer, OdometrySample, PITCH_JITTER_RAD, RobotState, RobotTrack,
 };
 use crate::synth::scenario::{Controller, Follow, Robot};
+use crate::synth::world::Obstacle;
 use crate::time::Nanos;
 
 /// One capture the loop needs: time (ns since the session start), the sensor's index in the
@@ -77,6 +82,8 @@ pub struct LoopSpec<'a> {
     /// The scenario seed (the robot's and the odometry's random streams) and session index.
     pub seed: u64,
     pub session: u64,
+    /// The footprints the robot cannot enter (`map`, where the robot's true pose lives).
+    pub obstacles: &'a [Obstacle],
 }
 
 /// The loop's answer at one scan.
@@ -89,6 +96,10 @@ pub struct ScanRecord {
     pub controller: Controller,
     /// The robot's odometry pose `[x, y, yaw]` in `odom` at the scan.
     pub robot: [f64; 3],
+    /// The platform's obstacle check changed the controller's command.
+    pub avoided: bool,
+    /// The footprint touched an obstacle since the previous scan (a step was refused).
+    pub contact: bool,
 }
 
 /// The closed-loop run: the robot's true track and every scan's record.
@@ -152,6 +163,8 @@ pub fn run<S: Sensors>(
         desired_distance: lim.desired_distance(0.0),
     };
     let mut scans = Vec::new();
+    let mut contact = false;
+    let mut around = avoid::Surroundings::default();
     for _ in 0..n {
         track.samples.push(s);
         odo.advance(&track);
@@ -207,7 +220,12 @@ pub fn run<S: Sensors>(
                         yaw: pose[2],
                         v: v_odo,
                     };
-                    cmd = command(spec.controller, &robot, &output, &mut trail, &lim);
+                    let plain = command(spec.controller, &robot, &output, &mut trail, &lim);
+                    let target = output.estimate.map(|e| e.position);
+                    let scan = avoid::obstacle_points(&input, target);
+                    let points = around.around(scan, &input.laser_pose, &robot);
+                    let avoided;
+                    (cmd, avoided) = avoid::apply(plain, &points, &lim, &f.platform);
                     scans.push(ScanRecord {
                         t,
                         stamp,
@@ -215,20 +233,39 @@ pub fn run<S: Sensors>(
                         command: cmd,
                         controller: spec.controller,
                         robot: pose,
+                        avoided,
+                        contact,
                     });
+                    contact = false;
                 }
             }
         }
         let prev_v = s.v;
         s.v += (cmd.v - s.v).clamp(-lim.max_decel * DT, lim.max_accel * DT);
         s.w = cmd.w;
+        let before = (s.x, s.y);
         robot::balance_and_drive(&mut s, prev_v, f, jitter.sample(&mut r));
+        if blocked(spec.obstacles, f.platform.radius_m, before, (s.x, s.y)) {
+            (s.x, s.y) = before;
+            s.v = 0.0;
+            contact = true;
+        }
     }
     Ok(ClosedLoop {
         track,
         scans,
         odometry: odo.samples,
     })
+}
+
+/// Whether a step of a footprint of `radius` from `from` to `to` runs into an obstacle: it
+/// ends overlapping one, deeper than it started (a footprint set down overlapping can leave).
+pub fn blocked(obstacles: &[Obstacle], radius: f64, from: (f64, f64), to: (f64, f64)) -> bool {
+    radius > 0.0
+        && obstacles.iter().any(|o| {
+            let d = o.distance(to.0, to.1);
+            d < radius && d < o.distance(from.0, from.1)
+        })
 }
 
 /// The controller's command for one scan's output; keeps the trail of estimates.

@@ -13,6 +13,8 @@
 //!   (coordinated-turn PDAF with the colour likelihood).
 //! - [`controller`]: direct following and pure pursuit on the estimated path, at the desired
 //!   following distance `d_follow + v²/(2·a_min)` (the term seed 001's `E_follow` subtracts).
+//! - [`avoid`]: the platform under the controllers — a footprint that cannot pass through
+//!   obstacles and a check of each command against the scan (our addition).
 //! - [`closed_loop`]: steps the robot at [`crate::synth::motion::DT`] with the balancing pitch,
 //!   captures the follower's sensors at the capture schedule's instants through a
 //!   [`closed_loop::Sensors`] the session provides, and records every scan's output.
@@ -23,6 +25,7 @@
 //! crossers therefore cross where the open-loop robot would have been, which is near, not on,
 //! the line to the closed-loop robot.
 
+pub mod avoid;
 pub mod closed_loop;
 pub mod controller;
 pub mod nearest_blob;

@@ -5,6 +5,7 @@ use std::convert::Infallible;
 
 use nalgebra::{Isometry3, Point3};
 
+use super::avoid::Platform;
 use super::closed_loop::{self, CaptureEvent, ClosedLoop, LoopSpec, Sensed, Sensors};
 use super::controller::{self, Limits, OdomPose, Trail};
 use super::nearest_blob::{LOST_AFTER_S, NearestBlobFollower};
@@ -13,6 +14,7 @@ use crate::laser::points::ScanGeometry;
 use crate::synth::motion::DT;
 use crate::synth::robot;
 use crate::synth::scenario::{Controller, Estimator, Follow, Robot, RobotMode};
+use crate::synth::world::Obstacle;
 use crate::time::Nanos;
 
 fn limits() -> Limits {
@@ -223,6 +225,7 @@ fn follow_spec() -> Follow {
         max_turn_rate: 1.5,
         estimator: Estimator::NearestBlob,
         pdaf: Default::default(),
+        platform: Default::default(),
     }
 }
 
@@ -243,6 +246,8 @@ fn robot_spec() -> Robot {
 struct DiscWorld {
     speed: f64,
     base_from_laser: Isometry3<f64>,
+    /// Static discs (trunks) in `map`: `(centre, radius)`.
+    statics: Vec<([f64; 2], f64)>,
 }
 
 impl DiscWorld {
@@ -278,11 +283,12 @@ impl Sensors for DiscWorld {
         let t = ev.t_ns as f64 * 1e-9;
         let p = self.person(t);
         let laser_from_map = (map_from_base * self.base_from_laser).inverse();
-        let discs: Vec<([f64; 2], f64)> = [0.12, -0.12]
-            .iter()
-            .map(|dy| {
-                let q = laser_from_map * Point3::new(p[0], p[1] + dy, 0.4);
-                ([q.x, q.y], 0.06)
+        let legs = [0.12, -0.12].iter().map(|dy| ([p[0], p[1] + dy], 0.06));
+        let discs: Vec<([f64; 2], f64)> = legs
+            .chain(self.statics.iter().copied())
+            .map(|(c, r)| {
+                let q = laser_from_map * Point3::new(c[0], c[1], 0.4);
+                ([q.x, q.y], r)
             })
             .collect();
         let (ranges, geometry) = disc_scan(&discs);
@@ -296,8 +302,21 @@ impl Sensors for DiscWorld {
 }
 
 fn run_disc_world(controller: Controller, follower: &mut dyn Follower) -> ClosedLoop {
+    run_among(controller, follower, &[], Platform::default())
+}
+
+/// [`run_disc_world`] among `trunks` (footprints, and discs on the scan) on `platform`.
+fn run_among(
+    controller: Controller,
+    follower: &mut dyn Follower,
+    trunks: &[Obstacle],
+    platform: Platform,
+) -> ClosedLoop {
     let robot = robot_spec();
-    let follow = follow_spec();
+    let follow = Follow {
+        platform,
+        ..follow_spec()
+    };
     let spec = LoopSpec {
         robot: &robot,
         follow: &follow,
@@ -305,10 +324,12 @@ fn run_disc_world(controller: Controller, follower: &mut dyn Follower) -> Closed
         duration: 15.0,
         seed: 7,
         session: 0,
+        obstacles: trunks,
     };
     let mut world = DiscWorld {
         speed: 1.2,
         base_from_laser: Isometry3::translation(0.25, 0.0, 0.4),
+        statics: trunks.iter().map(|o| ([o.x, o.y], o.hx)).collect(),
     };
     match closed_loop::run(&spec, &mut world, follower) {
         Ok(r) => r,
@@ -321,6 +342,7 @@ fn the_closed_loop_follows_a_walker_with_both_controllers() {
     let world = DiscWorld {
         speed: 1.2,
         base_from_laser: Isometry3::identity(),
+        statics: Vec::new(),
     };
     for controller in [Controller::Pursuit, Controller::Direct] {
         let mut f = NearestBlobFollower::new([3.0, 0.5]);
@@ -441,4 +463,78 @@ fn a_lost_target_turns_the_stopped_robot_towards_its_last_prediction() {
             .all(|s| s.command.w.abs() <= lim.max_turn_rate)
     );
     assert!(run.scans.iter().any(|s| s.t > lost_at && s.command.w > 0.5));
+}
+
+/// A trunk 0.2 m off the robot's straight path to a still target 20 m ahead: the footprint's
+/// 0.35 m cannot pass it.
+fn trunk_on_the_way() -> Obstacle {
+    Obstacle::disc(5.0, 0.2, 0.3)
+}
+
+/// Gives a still target at `at` (`odom`) at every scan.
+struct Still {
+    at: [f64; 2],
+}
+
+impl Follower for Still {
+    fn on_scan(&mut self, _input: &ScanInput<'_>) -> FollowerOutput {
+        FollowerOutput {
+            estimate: Some(still(self.at[0], self.at[1])),
+            reset: false,
+            look_at: None,
+        }
+    }
+}
+
+fn closest_approach(run: &ClosedLoop, o: &Obstacle) -> f64 {
+    run.track
+        .samples
+        .iter()
+        .map(|s| o.distance(s.x, s.y))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Without the obstacle check the robot drives into the trunk: every step that would overlap it
+/// deeper is refused (it stops there, and the next scan reports the contact) until turning
+/// towards the target lets it slide off; it never gets closer than its footprint.
+#[test]
+fn the_footprint_cannot_pass_through_a_trunk() {
+    let trunk = trunk_on_the_way();
+    let blind = Platform {
+        avoid: false,
+        ..Platform::default()
+    };
+    let mut goal = Still { at: [20.0, 0.0] };
+    let run = run_among(Controller::Direct, &mut goal, &[trunk], blind);
+    let closest = closest_approach(&run, &trunk);
+    assert!(closest >= blind.radius_m, "{closest}");
+    assert!(
+        closest < blind.radius_m + 0.05,
+        "never reached it: {closest}"
+    );
+    let held: Vec<f64> = run
+        .scans
+        .iter()
+        .filter(|s| s.contact)
+        .map(|s| s.t)
+        .collect();
+    assert!(held.len() >= 3, "{held:?}");
+    assert!(held.iter().all(|&t| run.track.state(t).v < 0.2));
+    assert!(run.scans.iter().all(|s| !s.avoided));
+}
+
+/// With the check (the default) the laser sees the trunk, the command turns onto a clear arc,
+/// and the robot passes it without touching, keeping the margin.
+#[test]
+fn the_obstacle_check_steers_the_robot_around_the_trunk() {
+    let trunk = trunk_on_the_way();
+    let p = Platform::default();
+    let mut goal = Still { at: [20.0, 0.0] };
+    let run = run_among(Controller::Direct, &mut goal, &[trunk], p);
+    assert!(run.scans.iter().all(|s| !s.contact));
+    assert!(run.scans.iter().any(|s| s.avoided));
+    let closest = closest_approach(&run, &trunk);
+    assert!(closest >= p.radius_m + 0.5 * p.margin_m, "{closest}");
+    let end = run.track.samples.last().expect("samples");
+    assert!(end.x > trunk.x + 5.0 && end.y.abs() < 1.0, "{end:?}");
 }

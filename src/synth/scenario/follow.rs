@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{MountFrame, SensorSpec};
 use crate::laser::follow::FollowSpec;
+use crate::synth::follow::avoid::Platform;
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -37,6 +38,10 @@ pub struct Follow {
     /// Settings of the `pdaf` estimator (every key optional; `laser::follow::FollowSpec`).
     #[serde(default)]
     pub pdaf: FollowSpec,
+    /// The platform under the controllers: footprint and obstacle check
+    /// (`synth::follow::avoid`).
+    #[serde(default)]
+    pub platform: Platform,
 }
 
 impl Follow {
@@ -116,6 +121,20 @@ fn loop_problem(f: &Follow, sensors: &[SensorSpec]) -> Option<(&'static str, Str
         return Some((
             "max_turn_rate",
             format!("{} is not positive", f.max_turn_rate),
+        ));
+    }
+    let pl = &f.platform;
+    if !(pl.radius_m >= 0.0
+        && pl.radius_m.is_finite()
+        && pl.margin_m >= 0.0
+        && pl.margin_m.is_finite())
+    {
+        return Some((
+            "platform",
+            format!(
+                "radius_m {} and margin_m {} must be finite and ≥ 0",
+                pl.radius_m, pl.margin_m
+            ),
         ));
     }
     if f.controllers.is_empty() {

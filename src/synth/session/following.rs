@@ -161,6 +161,7 @@ pub(super) fn run(
         duration: s.scenario.duration_s,
         seed: s.scenario.seed,
         session,
+        obstacles: &ses.world.obstacles,
     };
     let mut sensors = LoopSensors {
         ses,
@@ -199,6 +200,8 @@ pub(super) fn write_states(
                 desired_distance: rec.command.desired_distance,
                 robot: rec.robot,
                 look_at: rec.output.look_at,
+                avoided: rec.avoided,
+                contact: rec.contact,
             },
         )?;
     }

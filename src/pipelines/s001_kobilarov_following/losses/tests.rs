@@ -136,6 +136,8 @@ fn loop_row(t_s: f64, x: Option<f64>) -> super::super::tables::LoopRow {
         cmd_v: 0.0,
         cmd_w: 0.0,
         desired_m: 3.2,
+        avoided: false,
+        contact: false,
     }
 }
 

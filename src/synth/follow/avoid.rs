@@ -1,0 +1,396 @@
+//! The platform under the following controllers: a footprint that cannot pass through trees
+//! and bushes, and a local obstacle check on the robot's own laser (our addition; seed 001 is
+//! silent on both — its Segway RMP has "a human-size footprint" and drove 12 runs among
+//! "scattered trees and small bushes", so it did not drive through them).
+//!
+//! - **Footprint** ([`Platform::radius_m`]): a disc. The closed loop stops the robot where a
+//!   step would put the disc inside an obstacle's footprint (`synth::world::Obstacle`) and
+//!   logs the contact (a bumper's report); the controllers know nothing of it.
+//! - **Obstacle check** ([`apply`]), on by default (`avoid = false` is the controllers as
+//!   printed): the scan's returns — without ground hits (below [`GROUND_Z_M`] in `odom` with
+//!   the IMU's pitch) and without the target's own returns (within [`TARGET_CLEAR_M`] of its
+//!   estimate) — and those of the last [`MEMORY_SCANS`] scans that the laser, 0.25 m ahead of
+//!   the base with a 180° view, no longer sees (beside and behind it: [`Surroundings`]), in the
+//!   robot's planar frame; for the commanded arc, the path length before the disc grown by
+//!   `margin_m` touches one ([`free_length`], closed form on the arc). The command stands when
+//!   that length covers its stopping distance `v²/(2·a_min)` and one scan period of travel;
+//!   else the nearest yaw rate of a fan that does, at the same
+//!   speed; else the fan's arc allowing the highest speed, at that speed (its curvature kept);
+//!   else (boxed in within the margin) a turn in place towards the fan's freest arc. A
+//!   command to stand or turn in place is never changed (a disc turns in place).
+//!
+//! Written by hand: a dynamic-window style admissibility test on one scan, a few dozen lines
+//! with no crate that fits (navigation stacks are frameworks, not functions).
+
+use std::collections::VecDeque;
+
+use nalgebra::{Isometry3, Point3};
+use serde::{Deserialize, Serialize};
+
+use super::ScanInput;
+use super::controller::{Command, Limits, OdomPose};
+
+/// Returns below this height in `odom` (m) are the ground (the pitched laser's ground hits).
+pub const GROUND_Z_M: f64 = 0.1;
+/// Returns within this distance of the target's estimate (m) are the target.
+pub const TARGET_CLEAR_M: f64 = 0.6;
+/// One scan period (s): the command holds until the next scan.
+pub const REACTION_S: f64 = 0.1;
+/// Yaw rates in the fan, spread evenly over `±max_turn_rate`.
+pub const FAN: usize = 31;
+/// Scans whose returns are remembered where the laser no longer sees (2 s at 10 Hz).
+pub const MEMORY_SCANS: usize = 20;
+
+/// `[robot.follow.platform]`: the robot's footprint and its obstacle check.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Platform {
+    /// Footprint radius (m): seed 001's "human-size footprint", 0.7 m across.
+    pub radius_m: f64,
+    /// Clearance the obstacle check keeps beyond the footprint (m).
+    pub margin_m: f64,
+    /// Run the obstacle check on the controllers' commands.
+    pub avoid: bool,
+}
+
+impl Default for Platform {
+    fn default() -> Self {
+        Platform {
+            radius_m: 0.35,
+            margin_m: 0.15,
+            avoid: true,
+        }
+    }
+}
+
+/// The scan's obstacle returns in `odom` (see the module doc). `target`: the target's
+/// estimate in `odom`.
+pub fn obstacle_points(input: &ScanInput<'_>, target: Option<[f64; 2]>) -> Vec<[f64; 2]> {
+    let g = &input.geometry;
+    let mut out = Vec::new();
+    for (k, &r) in input.ranges.iter().enumerate() {
+        let r = f64::from(r);
+        if !(r.is_finite() && r >= g.range_min && r < g.range_max) {
+            continue;
+        }
+        let a = g.angle_min + k as f64 * g.angle_increment;
+        let p = input.laser_pose * Point3::new(r * a.cos(), r * a.sin(), 0.0);
+        if p.z < GROUND_Z_M {
+            continue;
+        }
+        if target.is_some_and(|t| (p.x - t[0]).hypot(p.y - t[1]) < TARGET_CLEAR_M) {
+            continue;
+        }
+        out.push([p.x, p.y]);
+    }
+    out
+}
+
+/// The returns the check looks at: the current scan's and, out of the laser's view, the
+/// remembered ones (all in `odom`).
+#[derive(Debug, Default)]
+pub struct Surroundings {
+    past: VecDeque<Vec<[f64; 2]>>,
+}
+
+impl Surroundings {
+    /// The current scan's returns (`odom`) with the remembered ones the laser at `laser_pose`
+    /// (`odom <- laser`) does not see, in the planar frame of `robot`; then `scan` joins the
+    /// memory.
+    pub fn around(
+        &mut self,
+        scan: Vec<[f64; 2]>,
+        laser_pose: &Isometry3<f64>,
+        robot: &OdomPose,
+    ) -> Vec<[f64; 2]> {
+        let to_laser = laser_pose.inverse();
+        let unseen = self.past.iter().flatten().filter(|q| {
+            let l = to_laser * Point3::new(q[0], q[1], laser_pose.translation.z);
+            l.x <= 0.0
+        });
+        let (s, c) = robot.yaw.sin_cos();
+        let local = scan
+            .iter()
+            .chain(unseen)
+            .map(|q| {
+                let (dx, dy) = (q[0] - robot.x, q[1] - robot.y);
+                [c * dx + s * dy, -s * dx + c * dy]
+            })
+            .collect();
+        if self.past.len() == MEMORY_SCANS {
+            self.past.pop_front();
+        }
+        self.past.push_back(scan);
+        local
+    }
+}
+
+/// Path length (m) along the arc of curvature `k` (1/m, left positive) from the origin heading
+/// +x before a disc of radius `radius` touches `p`, capped at `cap`; a point the disc already
+/// covers blocks (0) when it lies ahead (`x > 0`) and is ignored behind.
+pub fn point_free_length(p: [f64; 2], k: f64, radius: f64, cap: f64) -> f64 {
+    let [x, y] = p;
+    if x.hypot(y) <= radius {
+        return if x > 0.0 { 0.0 } else { cap };
+    }
+    if k.abs() < 1e-9 {
+        if x <= 0.0 || y.abs() > radius {
+            return cap;
+        }
+        return (x - (radius * radius - y * y).sqrt()).clamp(0.0, cap);
+    }
+    // turning right is turning left in the mirror image
+    let (y, rho) = if k > 0.0 {
+        (y, 1.0 / k)
+    } else {
+        (-y, -1.0 / k)
+    };
+    // centre (0, rho); the robot starts at angle 0 measured from -y towards +x
+    let (rx, ry) = (x, y - rho);
+    let d = rx.hypot(ry);
+    if (d - rho).abs() > radius {
+        return cap;
+    }
+    let phi = rx.atan2(-ry).rem_euclid(std::f64::consts::TAU);
+    let cos_alpha = ((rho * rho + d * d - radius * radius) / (2.0 * rho * d)).clamp(-1.0, 1.0);
+    (rho * (phi - cos_alpha.acos()).max(0.0)).min(cap)
+}
+
+/// The least [`point_free_length`] over `points` for the footprint's `radius` grown by
+/// `margin`; a point already inside the margin counts against the footprint alone (the margin
+/// is kept where it can be, so a robot that came too close can still leave).
+pub fn free_length(points: &[[f64; 2]], k: f64, radius: f64, margin: f64, cap: f64) -> f64 {
+    let grown = radius + margin;
+    points
+        .iter()
+        .map(|&p| {
+            let r = if p[0].hypot(p[1]) <= grown {
+                radius
+            } else {
+                grown
+            };
+            point_free_length(p, k, r, cap)
+        })
+        .fold(cap, f64::min)
+}
+
+/// The path a command at speed `v` needs clear: stopping distance and one scan of travel.
+fn needed(v: f64, lim: &Limits) -> f64 {
+    v * v / (2.0 * lim.max_decel) + v * REACTION_S
+}
+
+/// The highest speed whose [`needed`] length fits in `free`.
+fn speed_for(free: f64, lim: &Limits) -> f64 {
+    let a = lim.max_decel;
+    a * (-REACTION_S + (REACTION_S * REACTION_S + 2.0 * free.max(0.0) / a).sqrt())
+}
+
+/// The checked command and whether the check changed it (see the module doc).
+pub fn apply(cmd: Command, points: &[[f64; 2]], lim: &Limits, p: &Platform) -> (Command, bool) {
+    if !p.avoid || cmd.v <= 0.0 || points.is_empty() {
+        return (cmd, false);
+    }
+    let need = needed(cmd.v, lim);
+    let free = |w: f64| free_length(points, w / cmd.v, p.radius_m, p.margin_m, need);
+    if free(cmd.w) >= need {
+        return (cmd, false);
+    }
+    let fan: Vec<f64> = (0..FAN)
+        .map(|i| lim.max_turn_rate * (2.0 * i as f64 / (FAN - 1) as f64 - 1.0))
+        .collect();
+    let frees: Vec<f64> = fan.iter().map(|&w| free(w)).collect();
+    let closest = |ok: &dyn Fn(usize) -> bool| {
+        (0..FAN)
+            .filter(|&i| ok(i))
+            .min_by(|&a, &b| (fan[a] - cmd.w).abs().total_cmp(&(fan[b] - cmd.w).abs()))
+    };
+    if let Some(i) = closest(&|i| frees[i] >= need) {
+        return (Command { w: fan[i], ..cmd }, true);
+    }
+    // nothing clear at this speed: the arc allowing the highest speed, nearest the command
+    let speeds: Vec<f64> = frees
+        .iter()
+        .map(|&f| speed_for(f, lim).min(cmd.v))
+        .collect();
+    let best = speeds.iter().copied().fold(0.0, f64::max);
+    if best <= 1e-3 {
+        // boxed in within the margin: turn in place towards the freest arc
+        let most = frees.iter().copied().fold(0.0, f64::max);
+        let i = closest(&|i| frees[i] >= most).expect("the most free is one of them");
+        let side = |left: bool| -> f64 {
+            (0..FAN)
+                .filter(|&j| (fan[j] > 0.0) == left && fan[j] != 0.0)
+                .map(|j| frees[j])
+                .sum()
+        };
+        let w = match (fan[i], cmd.w) {
+            (0.0, 0.0) if side(true) >= side(false) => 0.5 * lim.max_turn_rate,
+            (0.0, 0.0) => -0.5 * lim.max_turn_rate,
+            (0.0, w) => w,
+            (w, _) => w,
+        };
+        return (Command { v: 0.0, w, ..cmd }, true);
+    }
+    let i = closest(&|i| speeds[i] >= best).expect("the best speed is one of them");
+    let v = speeds[i];
+    (
+        Command {
+            v,
+            w: fan[i] / cmd.v * v,
+            ..cmd
+        },
+        true,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lim() -> Limits {
+        Limits {
+            following_distance: 3.2,
+            max_speed: 3.5,
+            max_accel: 1.4,
+            max_decel: 1.4,
+            max_turn_rate: 1.5,
+        }
+    }
+
+    /// The arc's free length by walking it in 0.1 mm steps.
+    fn walked(p: [f64; 2], k: f64, radius: f64, cap: f64) -> f64 {
+        let step = 1e-4;
+        let mut s = 0.0;
+        while s < cap {
+            let (x, y) = if k.abs() < 1e-9 {
+                (s, 0.0)
+            } else {
+                ((k * s).sin() / k, (1.0 - (k * s).cos()) / k)
+            };
+            if (x - p[0]).hypot(y - p[1]) <= radius {
+                return s;
+            }
+            s += step;
+        }
+        cap
+    }
+
+    #[test]
+    fn free_length_on_a_line_and_on_a_circle_in_closed_form() {
+        let r = 0.35;
+        // straight: the disc's front reaches a point 0.2 m off the line
+        let got = point_free_length([3.0, 0.2], 0.0, r, 10.0);
+        assert!((got - (3.0 - (r * r - 0.04_f64).sqrt())).abs() < 1e-12);
+        assert_eq!(point_free_length([3.0, 0.4], 0.0, r, 10.0), 10.0);
+        // a point on a circle of radius 2 a quarter turn on: rho (pi/2 - 2 asin(r / 2 rho))
+        let want = 2.0 * (std::f64::consts::FRAC_PI_2 - 2.0 * (r / 4.0).asin());
+        for (p, k) in [([2.0, 2.0], 0.5), ([2.0, -2.0], -0.5)] {
+            let got = point_free_length(p, k, r, 10.0);
+            assert!((got - want).abs() < 1e-12, "{p:?} {k}: {got} vs {want}");
+        }
+        // already covered: blocks ahead, ignored behind
+        assert_eq!(point_free_length([0.2, 0.1], 0.3, r, 5.0), 0.0);
+        assert_eq!(point_free_length([-0.2, 0.1], 0.3, r, 5.0), 5.0);
+    }
+
+    #[test]
+    fn free_length_agrees_with_walking_the_arc() {
+        let mut worst: f64 = 0.0;
+        for i in 0..12 {
+            for j in 0..12 {
+                let p = [-1.0 + 0.37 * i as f64, -2.2 + 0.41 * j as f64];
+                if p[0].hypot(p[1]) <= 0.35 {
+                    continue; // covered at the start: the rule above, not a walk
+                }
+                for k in [-1.3, -0.4, 0.0, 0.25, 0.9] {
+                    let (a, b) = (point_free_length(p, k, 0.35, 4.0), walked(p, k, 0.35, 4.0));
+                    worst = worst.max((a - b).abs());
+                }
+            }
+        }
+        assert!(worst < 2e-4, "worst {worst}");
+    }
+
+    #[test]
+    fn a_clear_command_stands_and_standing_is_never_changed() {
+        let cmd = Command {
+            v: 2.0,
+            w: 0.3,
+            desired_distance: 4.6,
+        };
+        let far = [[20.0, 0.0], [0.0, 5.0]];
+        assert_eq!(apply(cmd, &far, &lim(), &Platform::default()), (cmd, false));
+        let turn = Command { v: 0.0, ..cmd };
+        let wall = [[0.5, 0.0]];
+        assert_eq!(
+            apply(turn, &wall, &lim(), &Platform::default()),
+            (turn, false)
+        );
+        let off = Platform {
+            avoid: false,
+            ..Platform::default()
+        };
+        assert_eq!(apply(cmd, &wall, &lim(), &off), (cmd, false));
+    }
+
+    #[test]
+    fn a_bush_ahead_turns_the_command_onto_the_nearest_clear_arc() {
+        let p = Platform::default();
+        let cmd = Command {
+            v: 2.0,
+            w: 0.0,
+            desired_distance: 4.6,
+        };
+        // a bush 2 m ahead, slightly left of the nose: returns on its near half
+        let bush: Vec<[f64; 2]> = (0..20)
+            .map(|i| {
+                let a = std::f64::consts::PI * (0.5 + i as f64 / 19.0);
+                [2.6 + 0.5 * a.cos(), 0.1 + 0.5 * a.sin()]
+            })
+            .collect();
+        let need = 4.0 / 2.8 + 0.2;
+        let (r, m) = (p.radius_m, p.margin_m);
+        assert!(free_length(&bush, 0.0, r, m, 10.0) < need);
+        let (got, changed) = apply(cmd, &bush, &lim(), &p);
+        assert!(changed);
+        assert_eq!(got.v, cmd.v);
+        // the nearest yaw rate of the fan that is clear, and it turns away (right)
+        assert!(got.w < 0.0, "{got:?}");
+        assert!(free_length(&bush, got.w / got.v, r, m, 10.0) >= need);
+        let step = 2.0 * 1.5 / (FAN - 1) as f64;
+        let nearer = got.w + step;
+        assert!(free_length(&bush, nearer / got.v, r, m, 10.0) < need);
+    }
+
+    #[test]
+    fn boxed_in_it_slows_to_what_the_room_allows_or_turns_in_place() {
+        let p = Platform::default();
+        let cmd = Command {
+            v: 3.0,
+            w: 0.0,
+            desired_distance: 6.4,
+        };
+        // a ring of returns 1.5 m around the robot: every arc meets it within 1 m
+        let ring: Vec<[f64; 2]> = (0..72)
+            .map(|i| {
+                let a = i as f64 * 5f64.to_radians();
+                [1.5 * a.cos(), 1.5 * a.sin()]
+            })
+            .collect();
+        let (got, changed) = apply(cmd, &ring, &lim(), &p);
+        assert!(changed);
+        let free = free_length(&ring, got.w / got.v, p.radius_m, p.margin_m, 10.0);
+        assert!(got.v > 0.0 && got.v < 3.0, "{got:?}");
+        assert!((needed(got.v, &lim()) - free).abs() < 1e-9);
+        // inside the margin the footprint alone counts: a crawl, at least what the straight
+        // arc's 0.1 m allows
+        let near: Vec<[f64; 2]> = ring.iter().map(|q| [q[0] * 0.3, q[1] * 0.3]).collect();
+        let (got, _) = apply(cmd, &near, &lim(), &p);
+        let crawl = 1.4 * (-0.1 + (0.01_f64 + 2.0 * 0.1 / 1.4).sqrt());
+        assert!(got.v >= crawl - 1e-12 && got.v < 1.01 * crawl, "{got:?}");
+        // touching ahead on every arc: stop and turn in place (left when nothing tells)
+        let touching: Vec<[f64; 2]> = ring.iter().map(|q| [q[0] * 0.2, q[1] * 0.2]).collect();
+        let (got, _) = apply(cmd, &touching, &lim(), &p);
+        assert_eq!((got.v, got.w), (0.0, 0.75));
+    }
+}
