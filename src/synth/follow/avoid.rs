@@ -9,20 +9,18 @@
 //! - **Obstacle check** ([`apply`]), on by default (`avoid = false` is the controllers as
 //!   printed): the scan's returns — without ground hits (below [`GROUND_Z_M`] in `odom` with
 //!   the IMU's pitch) and without the target's own returns (within [`TARGET_CLEAR_M`] of its
-//!   estimate) — and those of the last [`MEMORY_SCANS`] scans that the laser, 0.25 m ahead of
-//!   the base with a 180° view, no longer sees (beside and behind it: [`Surroundings`]), in the
-//!   robot's planar frame; for the commanded arc, the path length before the disc grown by
+//!   estimate) — with the earlier returns within [`MEMORY_RANGE_M`] that the laser, 0.25 m
+//!   ahead of the base with a 180° view, no longer sees (beside and behind it:
+//!   [`Surroundings`]), in the robot's planar frame; for the commanded arc, the path length before the disc grown by
 //!   `margin_m` touches one ([`free_length`], closed form on the arc). The command stands when
 //!   that length covers its stopping distance `v²/(2·a_min)` and one scan period of travel;
 //!   else the nearest yaw rate of a fan that does, at the same
 //!   speed; else the fan's arc allowing the highest speed, at that speed (its curvature kept);
-//!   else (boxed in within the margin) a turn in place towards the fan's freest arc. A
+//!   else (boxed in) a turn in place away from what blocks it ([`turn_away`]). A
 //!   command to stand or turn in place is never changed (a disc turns in place).
 //!
 //! Written by hand: a dynamic-window style admissibility test on one scan, a few dozen lines
 //! with no crate that fits (navigation stacks are frameworks, not functions).
-
-use std::collections::VecDeque;
 
 use nalgebra::{Isometry3, Point3};
 use serde::{Deserialize, Serialize};
@@ -38,8 +36,8 @@ pub const TARGET_CLEAR_M: f64 = 0.6;
 pub const REACTION_S: f64 = 0.1;
 /// Yaw rates in the fan, spread evenly over `±max_turn_rate`.
 pub const FAN: usize = 31;
-/// Scans whose returns are remembered where the laser no longer sees (2 s at 10 Hz).
-pub const MEMORY_SCANS: usize = 20;
+/// Returns are remembered where the laser no longer sees them while within this range (m).
+pub const MEMORY_RANGE_M: f64 = 2.0;
 
 /// `[robot.follow.platform]`: the robot's footprint and its obstacle check.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -86,11 +84,13 @@ pub fn obstacle_points(input: &ScanInput<'_>, target: Option<[f64; 2]>) -> Vec<[
     out
 }
 
-/// The returns the check looks at: the current scan's and, out of the laser's view, the
-/// remembered ones (all in `odom`).
+/// The returns the check looks at (all in `odom`): the current scan's, and earlier returns
+/// within [`MEMORY_RANGE_M`] of the robot that the laser no longer sees (beside and behind it;
+/// where the laser looks, its current scan replaces them, so a person who walked on leaves no
+/// trail in view).
 #[derive(Debug, Default)]
 pub struct Surroundings {
-    past: VecDeque<Vec<[f64; 2]>>,
+    memory: Vec<[f64; 2]>,
 }
 
 impl Surroundings {
@@ -104,23 +104,20 @@ impl Surroundings {
         robot: &OdomPose,
     ) -> Vec<[f64; 2]> {
         let to_laser = laser_pose.inverse();
-        let unseen = self.past.iter().flatten().filter(|q| {
-            let l = to_laser * Point3::new(q[0], q[1], laser_pose.translation.z);
-            l.x <= 0.0
-        });
+        let z = laser_pose.translation.z;
+        let near = |q: &[f64; 2]| (q[0] - robot.x).hypot(q[1] - robot.y) <= MEMORY_RANGE_M;
+        self.memory
+            .retain(|q| near(q) && (to_laser * Point3::new(q[0], q[1], z)).x <= 0.0);
         let (s, c) = robot.yaw.sin_cos();
         let local = scan
             .iter()
-            .chain(unseen)
+            .chain(&self.memory)
             .map(|q| {
                 let (dx, dy) = (q[0] - robot.x, q[1] - robot.y);
                 [c * dx + s * dy, -s * dx + c * dy]
             })
             .collect();
-        if self.past.len() == MEMORY_SCANS {
-            self.past.pop_front();
-        }
-        self.past.push_back(scan);
+        self.memory.extend(scan.into_iter().filter(near));
         local
     }
 }
@@ -185,6 +182,27 @@ fn speed_for(free: f64, lim: &Limits) -> f64 {
     a * (-REACTION_S + (REACTION_S * REACTION_S + 2.0 * free.max(0.0) / a).sqrt())
 }
 
+/// Boxed in: the turn in place, at least half the turn-rate limit, away from the side the
+/// blocking returns (ahead, within the grown footprint) lie on; towards the command's turn when
+/// they are balanced, left when that is nought too.
+fn turn_away(w_cmd: f64, points: &[[f64; 2]], p: &Platform, lim: &Limits) -> f64 {
+    let grown = p.radius_m + p.margin_m;
+    let lateral: f64 = points
+        .iter()
+        .filter(|q| q[0] > 0.0 && q[0].hypot(q[1]) <= grown)
+        .map(|q| q[1])
+        .sum();
+    let left = if lateral.abs() > 1e-9 {
+        lateral < 0.0
+    } else if w_cmd != 0.0 {
+        w_cmd > 0.0
+    } else {
+        true
+    };
+    let w = w_cmd.abs().max(0.5 * lim.max_turn_rate);
+    if left { w } else { -w }
+}
+
 /// The checked command and whether the check changed it (see the module doc).
 pub fn apply(cmd: Command, points: &[[f64; 2]], lim: &Limits, p: &Platform) -> (Command, bool) {
     if !p.avoid || cmd.v <= 0.0 || points.is_empty() {
@@ -214,22 +232,14 @@ pub fn apply(cmd: Command, points: &[[f64; 2]], lim: &Limits, p: &Platform) -> (
         .collect();
     let best = speeds.iter().copied().fold(0.0, f64::max);
     if best <= 1e-3 {
-        // boxed in within the margin: turn in place towards the freest arc
-        let most = frees.iter().copied().fold(0.0, f64::max);
-        let i = closest(&|i| frees[i] >= most).expect("the most free is one of them");
-        let side = |left: bool| -> f64 {
-            (0..FAN)
-                .filter(|&j| (fan[j] > 0.0) == left && fan[j] != 0.0)
-                .map(|j| frees[j])
-                .sum()
-        };
-        let w = match (fan[i], cmd.w) {
-            (0.0, 0.0) if side(true) >= side(false) => 0.5 * lim.max_turn_rate,
-            (0.0, 0.0) => -0.5 * lim.max_turn_rate,
-            (0.0, w) => w,
-            (w, _) => w,
-        };
-        return (Command { v: 0.0, w, ..cmd }, true);
+        return (
+            Command {
+                v: 0.0,
+                w: turn_away(cmd.w, points, p, lim),
+                ..cmd
+            },
+            true,
+        );
     }
     let i = closest(&|i| speeds[i] >= best).expect("the best speed is one of them");
     let v = speeds[i];
@@ -312,6 +322,33 @@ mod tests {
     }
 
     #[test]
+    fn memory_keeps_what_the_laser_no_longer_sees_nearby() {
+        let at = |x: f64| OdomPose {
+            x,
+            y: 0.0,
+            yaw: 0.0,
+            v: 1.0,
+        };
+        // the laser 0.25 m ahead of the base, level, facing +x
+        let laser = |x: f64| Isometry3::translation(x + 0.25, 0.0, 0.45);
+        let mut s = Surroundings::default();
+        // first scan at x = 0: a trunk point ahead-left, a walker ahead, something far ahead
+        let first = vec![[1.0, 0.6], [1.5, 0.0], [3.0, 0.0]];
+        assert_eq!(s.around(first, &laser(0.0), &at(0.0)).len(), 3);
+        // at x = 1.2: the trunk point is beside and behind the laser (kept), the walker has
+        // gone from the place the laser still sees (dropped), the far point is in view (dropped)
+        let got = s.around(vec![[4.0, 0.0]], &laser(1.2), &at(1.2));
+        assert_eq!(got.len(), 2, "{got:?}");
+        assert!((got[1][0] - -0.2).abs() < 1e-12 && (got[1][1] - 0.6).abs() < 1e-12);
+        // standing still, it stays remembered (memory is by place, not by time)
+        for _ in 0..50 {
+            assert_eq!(s.around(vec![], &laser(1.2), &at(1.2)).len(), 1);
+        }
+        // 2.5 m on, the trunk point is out of range
+        assert_eq!(s.around(vec![], &laser(3.3), &at(3.3)).len(), 0);
+    }
+
+    #[test]
     fn a_clear_command_stands_and_standing_is_never_changed() {
         let cmd = Command {
             v: 2.0,
@@ -388,9 +425,10 @@ mod tests {
         let (got, _) = apply(cmd, &near, &lim(), &p);
         let crawl = 1.4 * (-0.1 + (0.01_f64 + 2.0 * 0.1 / 1.4).sqrt());
         assert!(got.v >= crawl - 1e-12 && got.v < 1.01 * crawl, "{got:?}");
-        // touching ahead on every arc: stop and turn in place (left when nothing tells)
-        let touching: Vec<[f64; 2]> = ring.iter().map(|q| [q[0] * 0.2, q[1] * 0.2]).collect();
-        let (got, _) = apply(cmd, &touching, &lim(), &p);
+        // touching ahead: stop and turn in place away from the touch, left when balanced
+        let (got, _) = apply(cmd, &[[0.3, 0.1]], &lim(), &p);
+        assert_eq!((got.v, got.w), (0.0, -0.75));
+        let (got, _) = apply(cmd, &[[0.3, 0.1], [0.3, -0.1]], &lim(), &p);
         assert_eq!((got.v, got.w), (0.0, 0.75));
     }
 }
