@@ -16,7 +16,7 @@ mod follow;
 mod validate;
 pub use biron::BironSpec;
 use follow::follow_problem;
-pub use follow::{Controller, Estimator, Follow};
+pub use follow::{Controller, Estimator, Follow, Platform};
 
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {

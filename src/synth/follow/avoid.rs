@@ -22,11 +22,10 @@
 //! Written by hand: a dynamic-window style admissibility test on one scan, a few dozen lines
 //! with no crate that fits (navigation stacks are frameworks, not functions).
 
-use nalgebra::{Isometry3, Point3};
-use serde::{Deserialize, Serialize};
-
 use super::ScanInput;
 use super::controller::{Command, Limits, OdomPose};
+pub use crate::synth::scenario::Platform;
+use nalgebra::{Isometry3, Point3};
 
 /// Returns below this height in `odom` (m) are the ground (the pitched laser's ground hits).
 pub const GROUND_Z_M: f64 = 0.1;
@@ -38,28 +37,6 @@ pub const REACTION_S: f64 = 0.1;
 pub const FAN: usize = 31;
 /// Returns are remembered where the laser no longer sees them while within this range (m).
 pub const MEMORY_RANGE_M: f64 = 2.0;
-
-/// `[robot.follow.platform]`: the robot's footprint and its obstacle check.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Platform {
-    /// Footprint radius (m): seed 001's "human-size footprint", 0.7 m across.
-    pub radius_m: f64,
-    /// Clearance the obstacle check keeps beyond the footprint (m).
-    pub margin_m: f64,
-    /// Run the obstacle check on the controllers' commands.
-    pub avoid: bool,
-}
-
-impl Default for Platform {
-    fn default() -> Self {
-        Platform {
-            radius_m: 0.35,
-            margin_m: 0.15,
-            avoid: true,
-        }
-    }
-}
 
 /// The scan's obstacle returns in `odom` (see the module doc). `target`: the target's
 /// estimate in `odom`.

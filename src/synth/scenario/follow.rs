@@ -6,7 +6,6 @@ use serde::{Deserialize, Serialize};
 
 use super::{MountFrame, SensorSpec};
 use crate::laser::follow::FollowSpec;
-use crate::synth::follow::avoid::Platform;
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -42,6 +41,28 @@ pub struct Follow {
     /// (`synth::follow::avoid`).
     #[serde(default)]
     pub platform: Platform,
+}
+
+/// `[robot.follow.platform]`: the robot's footprint and its obstacle check.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Platform {
+    /// Footprint radius (m): seed 001's "human-size footprint", 0.7 m across.
+    pub radius_m: f64,
+    /// Clearance the obstacle check keeps beyond the footprint (m).
+    pub margin_m: f64,
+    /// Run the obstacle check on the controllers' commands.
+    pub avoid: bool,
+}
+
+impl Default for Platform {
+    fn default() -> Self {
+        Platform {
+            radius_m: 0.35,
+            margin_m: 0.15,
+            avoid: true,
+        }
+    }
 }
 
 impl Follow {
