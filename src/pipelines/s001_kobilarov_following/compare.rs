@@ -79,6 +79,11 @@ table_row! {
         pub scans_both: i64,
         pub mean_distance_m: Option<f64>,
         pub median_distance_m: Option<f64>,
+        /// Time (s) of the first scan where the two differ by more than [`AGREE_M`]; `None`
+        /// when they never do. Poses a few millimetres apart (the replay's from `/tf`, the
+        /// loop's from its odometer) can tip a blob or a reset decided by a hair, after which
+        /// the two follow different blobs.
+        pub agree_until_s: Option<f64>,
         pub replay_rst: i64,
         pub loop_rst: i64,
     }
@@ -430,11 +435,17 @@ fn literal_readings(data: &[&SessionData], p: &Params) -> Vec<TestRow> {
     out
 }
 
+/// `replay_check`: the replay and the loop agree while their estimates are this close (m),
+/// well under the laser's blob spread.
+pub const AGREE_M: f64 = 0.05;
+
 fn replay_rows(data: &[&SessionData], p: &Params) -> Vec<ReplayRow> {
+    let mean = |d: &[f64]| (!d.is_empty()).then(|| d.iter().sum::<f64>() / d.len() as f64);
     data.iter()
         .map(|d| {
             let rows: Vec<&TrackRow> = d.method(&p.loop_method).collect();
             let mut dist = Vec::new();
+            let mut agree_until = None;
             for l in d.closed_loop.iter().filter(|l| l.x.is_some()) {
                 let near = rows
                     .iter()
@@ -442,19 +453,23 @@ fn replay_rows(data: &[&SessionData], p: &Params) -> Vec<ReplayRow> {
                 if let Some(r) = near.filter(|r| (r.t_s - l.t_s).abs() < 0.02)
                     && let (Some(x), Some(y), Some(lx), Some(ly)) = (r.x, r.y, l.x, l.y)
                 {
-                    dist.push((x - lx).hypot(y - ly));
+                    let e = (x - lx).hypot(y - ly);
+                    if e > AGREE_M && agree_until.is_none() {
+                        agree_until = Some(l.t_s);
+                    }
+                    dist.push(e);
                 }
             }
             ReplayRow {
                 run: d.name.clone(),
                 scans_both: dist.len() as i64,
-                mean_distance_m: (!dist.is_empty())
-                    .then(|| dist.iter().sum::<f64>() / dist.len() as f64),
+                mean_distance_m: mean(&dist),
                 median_distance_m: {
                     let mut d = dist.clone();
                     d.sort_by(f64::total_cmp);
                     d.get(d.len() / 2).copied()
                 },
+                agree_until_s: agree_until,
                 replay_rst: rows.iter().filter(|r| r.reset).count() as i64,
                 loop_rst: d.closed_loop.iter().filter(|l| l.reset).count() as i64,
             }
