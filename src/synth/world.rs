@@ -269,38 +269,57 @@ impl Obstacle {
         }
     }
 
-    /// Distance from a point to the footprint (negative inside).
+    /// An upright ellipse: semi-axis `a` along `yaw`, `b` across it.
+    pub fn ellipse(x: f64, y: f64, a: f64, b: f64, yaw: f64) -> Obstacle {
+        Obstacle {
+            x,
+            y,
+            hx: a,
+            hy: b,
+            yaw,
+            round: true,
+        }
+    }
+
+    /// Distance from a point to the footprint (negative inside). Exact for discs and boxes; for
+    /// an ellipse, the distance to its outline along the ray from its centre (no shorter than
+    /// the true distance outside, equal on the axes).
     pub fn distance(&self, px: f64, py: f64) -> f64 {
         let (dx, dy) = (px - self.x, py - self.y);
-        if self.round {
+        if self.round && self.hx == self.hy {
             return dx.hypot(dy) - self.hx;
         }
         let (s, c) = self.yaw.sin_cos();
-        let (lx, ly) = (
-            (c * dx + s * dy).abs() - self.hx,
-            (-s * dx + c * dy).abs() - self.hy,
-        );
+        let (ux, uy) = (c * dx + s * dy, -s * dx + c * dy);
+        if self.round {
+            let n = ux.hypot(uy);
+            let k = (ux / self.hx).hypot(uy / self.hy);
+            return if k > 0.0 {
+                n * (1.0 - 1.0 / k)
+            } else {
+                -self.hx.min(self.hy)
+            };
+        }
+        let (lx, ly) = (ux.abs() - self.hx, uy.abs() - self.hy);
         let outside = lx.max(0.0).hypot(ly.max(0.0));
         outside + lx.max(ly).min(0.0)
     }
 
     /// Outline for drawing.
     pub fn outline(&self) -> Vec<(f64, f64)> {
+        let (s, c) = self.yaw.sin_cos();
+        let at = |lx: f64, ly: f64| (self.x + c * lx - s * ly, self.y + s * lx + c * ly);
         if self.round {
             return (0..16)
                 .map(|k| {
                     let a = k as f64 / 16.0 * std::f64::consts::TAU;
-                    (self.x + self.hx * a.cos(), self.y + self.hx * a.sin())
+                    at(self.hx * a.cos(), self.hy * a.sin())
                 })
                 .collect();
         }
-        let (s, c) = self.yaw.sin_cos();
         [(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)]
             .iter()
-            .map(|(ex, ey)| {
-                let (lx, ly) = (ex * self.hx, ey * self.hy);
-                (self.x + c * lx - s * ly, self.y + s * lx + c * ly)
-            })
+            .map(|(ex, ey)| at(ex * self.hx, ey * self.hy))
             .collect()
     }
 }
