@@ -79,11 +79,11 @@ table_row! {
         pub scans_both: i64,
         pub mean_distance_m: Option<f64>,
         pub median_distance_m: Option<f64>,
-        /// Time (s) of the first scan where the two differ by more than [`AGREE_M`]; `None`
-        /// when they never do. Poses a few millimetres apart (the replay's from `/tf`, the
-        /// loop's from its odometer) can tip a blob or a reset decided by a hair, after which
-        /// the two follow different blobs.
-        pub agree_until_s: Option<f64>,
+        /// Time (s) of the first scan from which the two stay more than [`AGREE_M`] apart for
+        /// [`PART_SCANS`] scans; `None` when they never do. Poses a few millimetres apart (the
+        /// replay's from `/tf`, the loop's from its odometer) can tip a blob or a reset
+        /// decided by a hair, after which the two follow different blobs.
+        pub parted_at_s: Option<f64>,
         pub replay_rst: i64,
         pub loop_rst: i64,
     }
@@ -436,8 +436,17 @@ fn literal_readings(data: &[&SessionData], p: &Params) -> Vec<TestRow> {
 }
 
 /// `replay_check`: the replay and the loop agree while their estimates are this close (m),
-/// well under the laser's blob spread.
+/// well under the laser's blob spread ...
 pub const AGREE_M: f64 = 0.05;
+/// ... and have parted once they stay farther apart for this many scans (1 s at 10 Hz).
+pub const PART_SCANS: usize = 10;
+
+/// The time of the first of [`PART_SCANS`] scans in a row farther apart than [`AGREE_M`].
+fn parted_at(dist: &[f64], times: &[f64]) -> Option<f64> {
+    dist.windows(PART_SCANS)
+        .position(|w| w.iter().all(|&e| e > AGREE_M))
+        .map(|i| times[i])
+}
 
 fn replay_rows(data: &[&SessionData], p: &Params) -> Vec<ReplayRow> {
     let mean = |d: &[f64]| (!d.is_empty()).then(|| d.iter().sum::<f64>() / d.len() as f64);
@@ -445,7 +454,7 @@ fn replay_rows(data: &[&SessionData], p: &Params) -> Vec<ReplayRow> {
         .map(|d| {
             let rows: Vec<&TrackRow> = d.method(&p.loop_method).collect();
             let mut dist = Vec::new();
-            let mut agree_until = None;
+            let mut times = Vec::new();
             for l in d.closed_loop.iter().filter(|l| l.x.is_some()) {
                 let near = rows
                     .iter()
@@ -453,11 +462,8 @@ fn replay_rows(data: &[&SessionData], p: &Params) -> Vec<ReplayRow> {
                 if let Some(r) = near.filter(|r| (r.t_s - l.t_s).abs() < 0.02)
                     && let (Some(x), Some(y), Some(lx), Some(ly)) = (r.x, r.y, l.x, l.y)
                 {
-                    let e = (x - lx).hypot(y - ly);
-                    if e > AGREE_M && agree_until.is_none() {
-                        agree_until = Some(l.t_s);
-                    }
-                    dist.push(e);
+                    dist.push((x - lx).hypot(y - ly));
+                    times.push(l.t_s);
                 }
             }
             ReplayRow {
@@ -469,7 +475,7 @@ fn replay_rows(data: &[&SessionData], p: &Params) -> Vec<ReplayRow> {
                     d.sort_by(f64::total_cmp);
                     d.get(d.len() / 2).copied()
                 },
-                agree_until_s: agree_until,
+                parted_at_s: parted_at(&dist, &times),
                 replay_rst: rows.iter().filter(|r| r.reset).count() as i64,
                 loop_rst: d.closed_loop.iter().filter(|l| l.reset).count() as i64,
             }
@@ -522,4 +528,24 @@ pub fn tables(data: &[&SessionData], p: &Params) -> anyhow::Result<Vec<Table>> {
         .with_precision("mean_distance_m", 3)
         .with_precision("median_distance_m", 3);
     Ok(vec![tm, tt, tr])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A one-scan spike does not part the two; ten scans in a row apart do, from the first.
+    #[test]
+    fn the_replay_parts_from_the_loop_only_when_it_stays_apart() {
+        let times: Vec<f64> = (0..40).map(|k| k as f64 * 0.1).collect();
+        let mut d = vec![0.004; 40];
+        d[3] = 0.2;
+        assert_eq!(parted_at(&d, &times), None);
+        for e in &mut d[20..30] {
+            *e = 0.06;
+        }
+        assert_eq!(parted_at(&d, &times), Some(2.0));
+        d[29] = 0.05;
+        assert_eq!(parted_at(&d, &times), None);
+    }
 }
