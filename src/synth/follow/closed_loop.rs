@@ -221,11 +221,15 @@ pub fn run<S: Sensors>(
                         v: v_odo,
                     };
                     let plain = command(spec.controller, &robot, &output, &mut trail, &lim);
-                    let target = output.estimate.map(|e| e.position);
-                    let scan = avoid::obstacle_points(&input, target);
-                    let points = around.around(scan, &input.laser_pose, &robot);
                     let avoided;
-                    (cmd, avoided) = avoid::apply(plain, &points, &lim, &f.platform);
+                    (cmd, avoided) = if f.platform.avoid {
+                        let target = output.estimate.map(|e| e.position);
+                        let scan = avoid::obstacle_points(&input, target);
+                        let points = around.around(scan, &input.laser_pose, &robot);
+                        avoid::apply(plain, &points, &lim, &f.platform)
+                    } else {
+                        (plain, false)
+                    };
                     scans.push(ScanRecord {
                         t,
                         stamp,
