@@ -443,19 +443,9 @@ mod platform_tests {
     #[test]
     fn contacts_count_the_onsets_not_the_scans() {
         let row = |contact: bool| LoopRow {
-            t_s: 0.0,
-            x: None,
-            y: None,
-            vx: None,
-            vy: None,
-            cov_norm: None,
-            reset: false,
-            controller: "direct".into(),
-            cmd_v: 0.0,
-            cmd_w: 0.0,
-            desired_m: 3.2,
             avoided: !contact,
             contact,
+            ..LoopRow::at(0.0, None)
         };
         let rows: Vec<LoopRow> = [true, true, false, false, true, false, true, true]
             .map(row)

@@ -134,6 +134,28 @@ table_row! {
     }
 }
 
+#[cfg(test)]
+impl LoopRow {
+    /// A test row: a direct-following scan at `t_s`, at `(x, 0)` when `x` is given.
+    pub(crate) fn at(t_s: f64, x: Option<f64>) -> LoopRow {
+        LoopRow {
+            t_s,
+            x,
+            y: x.map(|_| 0.0),
+            vx: None,
+            vy: None,
+            cov_norm: None,
+            reset: false,
+            controller: "direct".into(),
+            cmd_v: 0.0,
+            cmd_w: 0.0,
+            desired_m: 3.2,
+            avoided: false,
+            contact: false,
+        }
+    }
+}
+
 table_row! {
     /// Method 1 on one omni frame: the detection's bearing, the target's true bearing in the
     /// camera frame and the robot's speed: `method1`.

@@ -124,21 +124,7 @@ fn a_short_excursion_is_no_loss() {
 }
 
 fn loop_row(t_s: f64, x: Option<f64>) -> super::super::tables::LoopRow {
-    super::super::tables::LoopRow {
-        t_s,
-        x,
-        y: x.map(|_| 0.0),
-        vx: None,
-        vy: None,
-        cov_norm: None,
-        reset: false,
-        controller: "direct".into(),
-        cmd_v: 0.0,
-        cmd_w: 0.0,
-        desired_m: 3.2,
-        avoided: false,
-        contact: false,
-    }
+    super::super::tables::LoopRow::at(t_s, x)
 }
 
 /// Two runs of 8 s at 10 Hz, the person at (4, 0). Run a: occluded 1.0–1.5 s (coped: the
