@@ -276,6 +276,12 @@ fn other_pipelines_refuse_degenerate_values() {
     );
     check(s004, "nms_iou = 0.3 ", "nms_iou = 1.3 ", "params.nms_iou");
     check(
+        s004,
+        "accel_sigma_mps2 = 2.0 ",
+        "accel_sigma_mps2 = 0.0 ",
+        "params.accel_sigma_mps2",
+    );
+    check(
         "dataset_quality",
         "bin_s = 1.0 ",
         "bin_s = 0.0 ",

@@ -75,6 +75,20 @@ pub fn run(a: &Args, out: &mut dyn std::io::Write) -> anyhow::Result<()> {
                 )?;
             }
             let ds = wildtrack::read(dir, intr)?;
+            // the 3-D tracks' motion model (`accel_sigma_mps2`), from the development frames
+            let dev = &ds.frames[..ds.frames.len().min(wildtrack::DEVELOPMENT_FRAMES)];
+            if let Some(m) = wildtrack::motion_check(dev) {
+                writeln!(
+                    out,
+                    "annotated people, frames 0–{}: {} second differences of position {:.2} s \
+                     apart, median {:.3} m → white-noise acceleration σ {:.2} m/s²",
+                    dev.len().saturating_sub(1),
+                    m.samples,
+                    m.period_s,
+                    m.median_m,
+                    m.accel_sigma_mps2
+                )?;
+            }
             if ds.skipped > 0 {
                 writeln!(
                     out,

@@ -104,6 +104,10 @@ pub fn ground_position(position_id: u64) -> (f64, f64) {
     )
 }
 
+/// The annotated frames design values may be chosen on: the first 200 (frames 0–199, the
+/// development part of `pipelines/real/s004_wildtrack.toml`'s `split_frame`).
+pub const DEVELOPMENT_FRAMES: usize = 200;
+
 /// Last valid `positionID` (480 × 1440 grid).
 pub const POSITIONS: u64 = 480 * 1440;
 
@@ -644,5 +648,8 @@ pub fn write_noisy(
     })
 }
 
+mod motion;
 #[cfg(test)]
 mod tests;
+
+pub use motion::{MotionCheck, motion_check};

@@ -102,6 +102,11 @@ pub struct Params {
     pub room_m: [f64; 4],
     pub room_margin_m: f64,
     pub gate_m: f64,
+    /// σ of the 3-D tracks' white-noise acceleration on the ground (m/s², piecewise constant
+    /// over a frame period: `track::kalman::constant_velocity_2d`). 2.0 is the synthetic
+    /// office's value (25 fps); at WILDTRACK's 2 fps it is set from the annotated people's own
+    /// second differences (`peopletrack import wildtrack` prints it).
+    pub accel_sigma_mps2: f64,
     pub max_combinations: usize,
     /// New 3-D objects: `paper` (exhaustive combinations), `scalable` (pairwise ray seeds
     /// grown camera by camera, plus single-camera ground points) or `ground` (per frame on
@@ -187,6 +192,7 @@ impl Default for Params {
             room_m: [0.0, 0.0, 8.0, 8.5],
             room_margin_m: 0.5,
             gate_m: 1.0,
+            accel_sigma_mps2: 2.0,
             max_combinations: 20_000,
             association: Association::Paper,
             ground_separation_m: 0.5,
@@ -350,6 +356,15 @@ pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
         bad(
             "gate_m",
             format!("{} is not a positive distance in metres", p.gate_m),
+        );
+    }
+    if !(p.accel_sigma_mps2 > 0.0 && p.accel_sigma_mps2.is_finite()) {
+        bad(
+            "accel_sigma_mps2",
+            format!(
+                "{} is not a positive acceleration in m/s²",
+                p.accel_sigma_mps2
+            ),
         );
     }
     if !(p.room_margin_m >= 0.0 && p.room_margin_m.is_finite()) {

@@ -28,6 +28,7 @@ pub(crate) fn cylinder_params(
         room_m: p.room_m,
         room_margin_m: p.room_margin_m,
         gate_m: p.gate_m,
+        accel_sigma: p.accel_sigma_mps2,
         max_combinations: p.max_combinations,
         association: p.association,
         ground_separation_m: p.ground_separation_m,
