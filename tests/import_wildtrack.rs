@@ -231,3 +231,20 @@ fn real_wildtrack_boxes_fit_intrinsic_zero() {
     assert!(z.median_foot_px < 10.0 && z.median_head_px < 10.0, "{z:?}");
     assert!(z.median_foot_px < o.median_foot_px && z.median_head_px < o.median_head_px);
 }
+
+/// The real dataset's motion statistic behind `accel_sigma_mps2` in
+/// `pipelines/real/s004_wildtrack.toml`, against an independent computation (a Python script
+/// over the pipeline's `gt` table, frames 0–199): 4,362 second differences 0.5 s apart, median
+/// 0.158 m (= 0.025 √40 on the 2.5 cm grid), σ_a = √2 · 0.158 / (√(2 ln 2) · 0.25) = 0.76 m/s².
+#[test]
+fn real_wildtrack_motion_on_the_development_frames() {
+    let Some(dir) = common::real("wildtrack") else {
+        return;
+    };
+    let ds = wildtrack::read(&dir, Intrinsics::Zero).expect("read");
+    let m = wildtrack::motion_check(&ds.frames[..wildtrack::DEVELOPMENT_FRAMES]).expect("motion");
+    assert_eq!(m.samples, 4362, "{m:?}");
+    assert!((m.period_s - 0.5).abs() < 1e-12, "{m:?}");
+    assert!((m.median_m - 0.025 * 40f64.sqrt()).abs() < 1e-9, "{m:?}");
+    assert!((m.accel_sigma_mps2 - 0.76).abs() < 0.005, "{m:?}");
+}
