@@ -108,8 +108,9 @@
 //! 2.0 m/s² was chosen at 25 fps; at WILDTRACK's 2 fps it lets a track's velocity change by
 //! 1 m/s between frames, and most identity switches were tracks whose prediction had been
 //! thrown past the gate. WILDTRACK's file sets it from the annotated people's own second
-//! differences (`log::import::wildtrack::motion`: 0.76 m/s²), which halved the identity
-//! switches at every noise level (issue 32's third round, docs/s004_wildtrack.md).
+//! differences (`log::import::wildtrack::motion`: 0.76 m/s²), which cut the identity
+//! switches by 27–57 % at every noise level (issue 32's third round,
+//! docs/s004_wildtrack.md).
 //!
 //! What it does not do: no occlusion reasoning (a camera that sees a point whole is assumed to
 //! see a person there; people hidden by others in a crowd count as misses), no per-camera
