@@ -332,11 +332,18 @@ pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
             format!("{} is not a person's height in metres", p.person_height_m),
         );
     }
-    if !(p.p_th_px > 0.0 && p.p_th_px.is_finite()) {
-        bad(
-            "p_th_px",
-            format!("{} is not a positive number of pixels", p.p_th_px),
-        );
+    for (key, v, what) in [
+        ("p_th_px", p.p_th_px, "number of pixels"),
+        ("gate_m", p.gate_m, "distance in metres"),
+        (
+            "accel_sigma_mps2",
+            p.accel_sigma_mps2,
+            "acceleration in m/s²",
+        ),
+    ] {
+        if !(v > 0.0 && v.is_finite()) {
+            bad(key, format!("{v} is not a positive {what}"));
+        }
     }
     for (key, n) in [("n_app", p.n_app), ("n_dis", p.n_dis)] {
         if n == 0 {
@@ -351,21 +358,6 @@ pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
         if !(0.0..=1.0).contains(&v) {
             bad(key, format!("{v} is not in [0, 1]"));
         }
-    }
-    if !(p.gate_m > 0.0 && p.gate_m.is_finite()) {
-        bad(
-            "gate_m",
-            format!("{} is not a positive distance in metres", p.gate_m),
-        );
-    }
-    if !(p.accel_sigma_mps2 > 0.0 && p.accel_sigma_mps2.is_finite()) {
-        bad(
-            "accel_sigma_mps2",
-            format!(
-                "{} is not a positive acceleration in m/s²",
-                p.accel_sigma_mps2
-            ),
-        );
     }
     if !(p.room_margin_m >= 0.0 && p.room_margin_m.is_finite()) {
         bad(
