@@ -46,9 +46,17 @@
 //! with `ρ` the prior density of people on the ground (per m²), `P_D` the probability that a
 //! camera seeing a person whole has a box of it, `μ_c = λ / A_c` the density of false boxes of
 //! camera `c` on the ground (`λ` false boxes per camera frame, spread over the ground `A_c` the
-//! camera sees whole, as the noise model draws them), `a_c = π (g_c d_c / f_c)²` the ground
-//! area of the box's gate (`g_c` its gate in px, `d_c` the camera's distance to the feet, `f_c`
-//! its focal length) and `a₀` the smallest of them (the person's localisation cell). For one
+//! camera sees whole, as the noise model draws them), `a_c = π (g_c d_c / f_c)² · s_c` the
+//! ground area of the box's gate (`g_c` its gate in px, `d_c` the camera's distance to the
+//! feet, `f_c` its focal length) and `a₀` the smallest of the discs `π (g_c d_c / f_c)²` (the
+//! person's localisation cell; a one-camera person's is its `a_c`). `s_c = max(1, d_c / z_c)`
+//! (`ray_gate`, `z_c` the camera's height) stretches the gate along the line of sight: a box
+//! places the feet `d_c / z_c` times worse in depth than across (the foot point's row over a
+//! ground seen at a slant), as the position's σ below already says, so a box is consistent
+//! with every person standing on that stretch of its ray — in a crowd, with a neighbour's too.
+//! Rounds 1–3 used the disc (`s_c = 1`, `ray_gate = false`), which made two boxes of two
+//! different people crossing on the ground as strong as one person's; the stretch was chosen
+//! on WILDTRACK's development frames (issue 32's fourth round, docs/s004_wildtrack.md). For one
 //! camera the cell cancels: `ℓ = ln(ρ P_D A_c / λ) + (misses) · ln(1 − P_D)`. So a box that
 //! only one of four cameras seeing the spot has is doubtful — three cameras say no one is
 //! there — while a person seen by one camera at the edge of the coverage, or by two of two,
@@ -160,6 +168,9 @@ pub struct OccupancyParams {
     /// With `select = "evidence"`: the confirmed tracks' predictions raise the prior density
     /// of people where they point (module doc).
     pub track_prior: bool,
+    /// A box's gate on the ground is stretched along the camera's line of sight by
+    /// `d_c / z_c` (module doc); `false`: a disc of the gate's radius across it (rounds 1–3).
+    pub ray_gate: bool,
 }
 
 /// How the `occupancy` association chooses a frame's people among its candidates.
@@ -186,6 +197,7 @@ impl Default for OccupancyParams {
             max_coast_frames: 2,
             select: OccupancySelect::Evidence,
             track_prior: true,
+            ray_gate: true,
         }
     }
 }
@@ -343,13 +355,20 @@ impl CylinderTracker {
             let (f, _) = view.focal_and_principal();
             let d = (view.center() - foot).norm();
             let r = self.gate_px(o) * d / f;
-            let a = std::f64::consts::PI * r * r;
-            cell = cell.min(a);
+            let disc = std::f64::consts::PI * r * r;
+            depth = d / view.center().z.max(0.1);
+            // the box's gate on the ground: `r` across the line of sight, `depth` times more
+            // along it (`ray_gate`); a one-camera person is localised only that well
+            let a = if q.ray_gate {
+                disc * depth.max(1.0)
+            } else {
+                disc
+            };
+            cell = cell.min(if h.support.len() == 1 { a } else { disc });
             // a camera that sees none of the room whole: its false boxes are everywhere
             let mu = q.false_per_frame / area.max(a);
             detected += (q.p_detect / (mu * a)).ln();
             information += (P90_SIGMAS / r).powi(2);
-            depth = d / view.center().z.max(0.1);
         }
         if !cell.is_finite() {
             return (f64::NEG_INFINITY, self.params.position_sigma_m);

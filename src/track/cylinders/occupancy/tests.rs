@@ -102,6 +102,58 @@ fn a_one_camera_person_s_log_odds_is_its_closed_form() {
     assert!(want < 0.0, "one box of seven: doubtful");
 }
 
+/// ℓ of a person seen by two cameras of the crowd rig, by hand: `ln(ρ a₀)` with `a₀` the
+/// smaller gate disc, each box `ln(P_D / (μ_c a_c))` with `a_c` its disc stretched by `d_c / z_c`
+/// under `ray_gate` (the disc alone without), and the five silent cameras' misses.
+#[test]
+fn a_two_camera_person_s_log_odds_is_its_closed_form_with_and_without_the_ray_gate() {
+    let views = crowd_views();
+    let (x, y, h) = (6.0, 6.0, 1.8);
+    for ray_gate in [true, false] {
+        let p = CylinderParams {
+            occupancy: OccupancyParams {
+                ray_gate,
+                ..occupancy()
+            },
+            ..params()
+        };
+        let t = CylinderTracker::new(views.clone(), p).expect("tracker");
+        let objs: Vec<Object2d> = objects(&views, &[(1, x, y, h)])
+            .into_iter()
+            .filter(|o| o.camera < 2)
+            .collect();
+        let got = people_and_odds(&t, &objs);
+        assert_eq!(got.len(), 1, "one person of two boxes");
+        let q = p.occupancy;
+        let foot = Point3::new(x, y, 0.0);
+        let (mut l, mut cell) = (0.0, f64::INFINITY);
+        for (c, v) in views.iter().enumerate().take(2) {
+            let (f, _) = v.focal_and_principal();
+            let d = (v.center() - foot).norm();
+            let r = p.p_th_px * d / f;
+            let disc = std::f64::consts::PI * r * r;
+            let stretch = if ray_gate {
+                (d / v.center().z).max(1.0)
+            } else {
+                1.0
+            };
+            assert!(
+                stretch > 1.5 || !ray_gate,
+                "the rig's cameras look at a slant"
+            );
+            let mu = q.false_per_frame / t.seen_area_m2()[c];
+            l += (q.p_detect / (mu * disc * stretch)).ln();
+            cell = cell.min(disc);
+        }
+        let want = (q.people_per_m2 * cell).ln() + l + 5.0 * (1.0 - q.p_detect).ln();
+        assert!(
+            (got[0].1 - want).abs() < 1e-6,
+            "ray_gate {ray_gate}: {} vs {want}",
+            got[0].1
+        );
+    }
+}
+
 #[test]
 fn with_exact_boxes_everyone_is_found_and_confirmed_in_the_first_frame() {
     let views = crowd_views();
