@@ -32,6 +32,7 @@ mod s001_kobilarov_following;
 mod s003_biron_anchoring;
 mod s003_zivkovic_background;
 mod s004_mohedano_multicam;
+mod s004_wildtrack;
 mod score_cli;
 mod shards;
 mod skipped_sessions;
