@@ -71,16 +71,17 @@ impl Default for SystemParams {
     /// the recogniser gate of 0.5 m and half the utterance (a priori), a pre-roll of one
     /// sound block (a priori, round 6; module doc).
     fn default() -> Self {
+        let sound_block_s = 0.5;
         SystemParams {
             fusion: FusionParams::default(),
             gcc: GccParams::default(),
             activity: ActivityParams::default(),
-            sound_block_s: 0.5,
+            sound_block_s,
             mic_spacing_m: doa::BIRON_SPACING_M,
             mic_height_m: doa::BIRON_MIC_HEIGHT_M,
             asr_beam_m: 0.5,
             asr_share: 0.5,
-            asr_preroll_s: 0.5,
+            asr_preroll_s: sound_block_s,
             dt_s: 0.1,
         }
     }
