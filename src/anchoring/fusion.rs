@@ -2,10 +2,13 @@
 //! doc of [`super`]). Positions are in the world (the fixed frame the laser tracker uses);
 //! bearings are world azimuths seen from the camera or from the microphones' centre.
 //!
-//! - **Legs**: each confirmed track of the laser people tracker grounds the anchor that holds
-//!   its id; a new track is adopted by the nearest anchor within [`FusionParams::adopt_m`] that
-//!   has no track or whose track the tracker dropped, else starts a new anchor. The anchor's
-//!   position is its track's.
+//! - **Legs**: each confirmed track of the laser people tracker that a detection updated in
+//!   this scan grounds the anchor that holds its id (a track coasting on its prediction is no
+//!   percept: the legs component is then associated, for as long as the tracker coasts; until
+//!   round 6 a coasting track grounded it too, [`FusionParams::coasting_grounds_legs`]); a new
+//!   track is adopted by the nearest anchor within [`FusionParams::adopt_m`] that has no track
+//!   or whose track the tracker dropped, else starts a new anchor. The anchor's position is its
+//!   track's, predicted or updated.
 //! - **Faces**: a face's bearing is associated with the anchor nearest in bearing within
 //!   [`FusionParams::face_gate_rad`] whose distance agrees with the face's width within
 //!   [`FusionParams::face_range_ratio`]; it grounds the face component and gives the person's
@@ -24,7 +27,11 @@
 //!   bearing difference ([`VoiceGate::Azimuth`]), a gate that narrows in delay towards the
 //!   microphone axis, where one sample of delay spans the most degrees.
 //!
-//! An anchor is dropped when every component is lost.
+//! An anchor is dropped when its legs and its face are both lost: the two percepts that give
+//! a position on their own (since round 7; chosen on the development split, where of 356
+//! anchor-steps held by torso or voice alone, or by legs the tracker had dropped, 6 lay within
+//! 0.5 m of a person). The torso and the voice label and move an anchor one of them holds;
+//! rounds 1–6 kept an anchor while any component was alive ([`FusionParams::cues_keep_anchor`]).
 
 use nalgebra::Point3;
 
@@ -79,6 +86,13 @@ pub struct FusionParams {
     /// The torso grounds a person only this long (s) after its legs or face last did (the
     /// colour alone would hold a phantom on a background of its own colour).
     pub torso_hold_s: f64,
+    /// A confirmed track that coasted (no detection this scan) grounds the legs too: rounds
+    /// 1–6, when a person who left kept a grounded anchor for the tracker's coast (1 s) and an
+    /// associated one for the timeout after it. Off by default (the component's own
+    /// definition: grounded by a percept).
+    pub coasting_grounds_legs: bool,
+    /// The torso or the voice alone keeps an anchor (rounds 1–6; module doc). Off by default.
+    pub cues_keep_anchor: bool,
 }
 
 impl Default for FusionParams {
@@ -98,6 +112,8 @@ impl Default for FusionParams {
             default_height_m: 1.70,
             torso_min_rho: 0.6,
             torso_hold_s: 3.0,
+            coasting_grounds_legs: false,
+            cues_keep_anchor: false,
         }
     }
 }
@@ -107,6 +123,8 @@ impl Default for FusionParams {
 pub struct LegTrack {
     pub id: u64,
     pub position: [f64; 2],
+    /// A detection updated it in this scan (else it coasted on its prediction).
+    pub updated: bool,
 }
 
 /// A person anchor.
@@ -224,7 +242,9 @@ impl Fusion {
             let a = &mut self.anchors[k];
             a.leg_track = Some(tr.id);
             a.position = tr.position;
-            a.legs.ground(t);
+            if tr.updated || self.params.coasting_grounds_legs {
+                a.legs.ground(t);
+            }
         }
     }
 
@@ -339,10 +359,15 @@ impl Fusion {
         Some(self.anchors[k].id)
     }
 
-    /// Drop the anchors whose every component is lost.
+    /// Drop the anchors whose legs and face are lost (or, with
+    /// [`FusionParams::cues_keep_anchor`], whose every component is lost).
     pub fn prune(&mut self, t: f64) {
-        self.anchors
-            .retain(|a| a.states(t).iter().any(|s| *s != State::Lost));
+        let any = self.params.cues_keep_anchor;
+        self.anchors.retain(|a| {
+            a.legs.alive(t)
+                || a.face.alive(t)
+                || (any && a.states(t).iter().any(|s| *s != State::Lost))
+        });
     }
 
     /// Speaking (voice alive) and looking (`None`: out of the camera's view; else a face
@@ -372,10 +397,12 @@ mod tests {
                 LegTrack {
                     id: 7,
                     position: at(2.0, 20.0),
+                    updated: true,
                 },
                 LegTrack {
                     id: 9,
                     position: at(1.5, -30.0),
+                    updated: true,
                 },
             ],
         );
@@ -391,6 +418,7 @@ mod tests {
             &[LegTrack {
                 id: 7,
                 position: at(2.1, 20.0),
+                updated: true,
             }],
         );
         assert_eq!(f.anchors.len(), 2, "a known track moves its anchor");
@@ -403,6 +431,71 @@ mod tests {
             f.anchors.is_empty(),
             "every component lost after the legs' 1 s timeout"
         );
+    }
+
+    #[test]
+    fn the_torso_or_the_voice_alone_keeps_an_anchor_only_in_the_old_variant() {
+        for (cues_keep_anchor, face, kept) in [
+            (false, false, false),
+            (true, false, true),
+            (false, true, true),
+        ] {
+            let p = FusionParams {
+                cues_keep_anchor,
+                ..FusionParams::default()
+            };
+            let mut f = Fusion::new(p, Modalities::ALL);
+            let track = LegTrack {
+                id: 2,
+                position: at(2.0, 0.0),
+                updated: true,
+            };
+            f.legs(0.0, &[track]);
+            // legs last seen at 0.0 (lost after 1.0); torso and voice grounded at 1.1
+            let a = &mut f.anchors[0];
+            a.torso.ground(1.1);
+            a.voice.ground(1.1);
+            if face {
+                a.face.ground(1.1);
+            }
+            f.prune(1.2);
+            assert_eq!(!f.anchors.is_empty(), kept, "{cues_keep_anchor} {face}");
+        }
+    }
+
+    #[test]
+    fn a_coasting_track_moves_its_anchor_but_grounds_it_only_in_the_old_variant() {
+        // a person walks out at 1 m/s: detections until t = 1.0, then the tracker coasts
+        // (reports its prediction) for 1 s before deleting the track
+        let run = |coasting_grounds_legs: bool| {
+            let p = FusionParams {
+                coasting_grounds_legs,
+                ..FusionParams::default()
+            };
+            let mut f = Fusion::new(p, Modalities::ALL);
+            let mut alive_until = 0.0;
+            for k in 0..=40 {
+                let t = f64::from(k) * 0.1;
+                if t <= 2.0 + 1e-9 {
+                    let track = LegTrack {
+                        id: 4,
+                        position: [2.0 + t, 0.0],
+                        updated: t <= 1.0 + 1e-9,
+                    };
+                    f.legs(t, &[track]);
+                }
+                f.prune(t);
+                if !f.anchors.is_empty() {
+                    alive_until = t;
+                    assert!((f.anchors[0].position[0] - (2.0 + t.min(2.0))).abs() < 1e-9);
+                }
+            }
+            alive_until
+        };
+        // grounded by the last detection at 1.0, associated for the 1 s timeout: gone after 2.0
+        assert!((run(false) - 2.0).abs() < 1e-9, "{}", run(false));
+        // rounds 1-6: the coast grounds it until 2.0, then the 1 s timeout: gone after 3.0
+        assert!((run(true) - 3.0).abs() < 1e-9, "{}", run(true));
     }
 
     #[test]
@@ -439,7 +532,14 @@ mod tests {
                 };
                 let mut f = Fusion::new(p, Modalities::ALL);
                 let (id, position) = (3, at(2.0, deg_person));
-                f.legs(0.0, &[LegTrack { id, position }]);
+                f.legs(
+                    0.0,
+                    &[LegTrack {
+                        id,
+                        position,
+                        updated: true,
+                    }],
+                );
                 // microphones at the mouth's height: no elevation
                 let mics = [0.0, 0.0, f.anchors[0].mouth_z()];
                 f.sound(0.0, deg_sound.to_radians(), mics, 0.0).is_some()

@@ -40,7 +40,7 @@ use crate::audio::gcc_phat::{GccError, GccParams, GccPhat};
 use crate::laser::legs::{self, LegParams};
 use crate::laser::points::{self, ScanGeometry};
 use crate::laser::segment::{self, SegmentOptions};
-use crate::laser::tracker::{PeopleTracker, TrackerParams};
+use crate::laser::tracker::{PeopleTracker, TrackerParams, Update};
 use crate::vision::colortrack::BinImage;
 use crate::vision::faces::Face;
 
@@ -123,6 +123,7 @@ impl LegFront {
             .map(|tr| LegTrack {
                 id: tr.id,
                 position: [tr.position().x, tr.position().y],
+                updated: tr.last != Update::Missed,
             })
             .collect()
     }
@@ -351,6 +352,7 @@ mod tests {
             &[LegTrack {
                 id: 1,
                 position: [2.0, 0.0],
+                updated: true,
             }],
         );
         s.attention.mode = Mode::Listen;
