@@ -362,11 +362,9 @@ impl Fusion {
     /// Drop the anchors whose legs and face are lost (or, with
     /// [`FusionParams::cues_keep_anchor`], whose every component is lost).
     pub fn prune(&mut self, t: f64) {
-        let any = self.params.cues_keep_anchor;
+        let cues = self.params.cues_keep_anchor;
         self.anchors.retain(|a| {
-            a.legs.alive(t)
-                || a.face.alive(t)
-                || (any && a.states(t).iter().any(|s| *s != State::Lost))
+            a.legs.alive(t) || a.face.alive(t) || (cues && (a.torso.alive(t) || a.voice.alive(t)))
         });
     }
 
