@@ -50,7 +50,7 @@ use image::RgbImage;
 use nalgebra::Isometry3;
 
 use crate::geometry::camera::Paracatadioptric;
-use crate::laser::points::ScanPoint;
+use crate::laser::points::{self, ScanPoint};
 use crate::laser::segment::{self, SegmentOptions, Threshold};
 use serde::{Deserialize, Serialize};
 
@@ -104,6 +104,11 @@ pub struct FollowParams {
     /// normalised correlation with the template is below `reacquire_corr`, the track is
     /// dropped as by `rst` and re-acquired by colour (see the module doc).
     pub colour_watch_s: Option<f64>,
+    /// Our reading of seed 001 §VI, off in the paper's configuration: returns placed (with
+    /// the IMU's pitch and roll) below this height in the fixed frame are the ground and make
+    /// no blob — "there are no valid measurements of the human" while the laser sees the
+    /// ground ([`points::above_ground`]; needs [`ScanObs::laser_pose`]).
+    pub ground_below_m: Option<f64>,
     /// Our addition, off in the paper's configuration: tracks of the other people, whose
     /// blobs then count less as the target's ([`others`]).
     pub others: Option<OthersParams>,
@@ -135,6 +140,7 @@ impl Default for FollowParams {
             reinit_max_m: 10.0,
             cylinder: [720, 120],
             colour_watch_s: None,
+            ground_below_m: None,
             others: None,
         }
     }
@@ -175,6 +181,8 @@ pub struct FollowSpec {
     pub reinit_max_m: f64,
     /// The colour watchdog (our addition; absent: off, the paper's tracker).
     pub colour_watch_s: Option<f64>,
+    /// Ground hits make no blob (our reading; absent: off, the paper's configuration).
+    pub ground_below_m: Option<f64>,
     /// Tracks of the other people discount their blobs (our addition, [`others`]; false: the
     /// paper's tracker).
     pub others: bool,
@@ -213,6 +221,7 @@ impl Default for FollowSpec {
             reinit_radius_m: p.reinit_radius_m,
             reinit_max_m: p.reinit_max_m,
             colour_watch_s: p.colour_watch_s,
+            ground_below_m: p.ground_below_m,
             others: p.others.is_some(),
         }
     }
@@ -261,6 +270,7 @@ impl FollowSpec {
             reinit_max_m: self.reinit_max_m,
             cylinder: FollowParams::default().cylinder,
             colour_watch_s: self.colour_watch_s,
+            ground_below_m: self.ground_below_m,
             others: self.others.then(OthersParams::default),
         }
     }
@@ -302,6 +312,11 @@ impl FollowSpec {
                 "clutter_density".into(),
                 format!("{} must be finite and >= 0", self.clutter_density),
             ));
+        }
+        if let Some(g) = self.ground_below_m
+            && !(g.is_finite() && (0.0..=1.0).contains(&g))
+        {
+            out.push(("ground_below_m".into(), format!("{g} is not in [0, 1] m")));
         }
         if let Some(w) = self.colour_watch_s
             && !(w.is_finite() && w > 0.0)
@@ -401,6 +416,8 @@ pub struct ScanObs<'a> {
     /// The scan's returns, fixed frame filled in.
     pub points: &'a [ScanPoint],
     pub omni: Option<OmniFrame<'a>>,
+    /// `fixed <- laser`, the pose `points` were placed with (for `ground_below_m`).
+    pub laser_pose: Option<&'a Isometry3<f64>>,
 }
 
 /// The filter's estimate (fixed frame).
@@ -577,7 +594,10 @@ impl FollowTracker {
 
     /// Process one scan (see the module doc).
     pub fn step(&mut self, obs: &ScanObs<'_>) -> Result<StepOutput, FilterError> {
-        let bl = blobs(obs.points, &self.params);
+        let bl = match (self.params.ground_below_m, obs.laser_pose) {
+            (Some(z), Some(pose)) => blobs(&points::above_ground(obs.points, pose, z).0, &self.params),
+            _ => blobs(obs.points, &self.params),
+        };
         let hists = self.histograms(&bl, obs.omni.as_ref());
         let corrs = self.correlations(&hists);
         let lr: Vec<f64> = corrs

@@ -89,6 +89,23 @@ pub fn project(
         .collect()
 }
 
+/// The points whose return lies at least `min_z` above the fixed frame's `z = 0` (the ground
+/// plane of `odom` on a wheeled robot), with the pose the scan was placed with — a pitched
+/// laser's ground hits removed. Returns the kept points and how many were dropped.
+pub fn above_ground(
+    points: &[ScanPoint],
+    pose: &Isometry3<f64>,
+    min_z: f64,
+) -> (Vec<ScanPoint>, usize) {
+    let kept: Vec<ScanPoint> = points
+        .iter()
+        .filter(|q| (pose * Point3::new(q.sensor.x, q.sensor.y, 0.0)).z >= min_z)
+        .copied()
+        .collect();
+    let dropped = points.len() - kept.len();
+    (kept, dropped)
+}
+
 /// A sensor-frame point in the fixed frame (identity without a pose).
 pub fn to_fixed(pose: Option<&Isometry3<f64>>, p: Point2<f64>) -> Point2<f64> {
     match pose {
@@ -161,6 +178,34 @@ mod tests {
         }
         let no_pose = project(&[1.0, 2.0, 3.0], &geometry(), None);
         assert!(no_pose.iter().all(|p| p.fixed == p.sensor));
+    }
+
+    /// A laser 0.45 m up, pitched 10° nose down: a beam straight ahead meets the ground at
+    /// 0.45 / sin 10° = 2.591 m, so a return at 2 m is 0.103 m up (kept at 0.1 m) and one at
+    /// 3 m is 0.071 m below the ground plane (dropped); the beams at ±90° stay at 0.45 m.
+    #[test]
+    fn above_ground_drops_the_returns_of_a_pitched_laser_on_the_ground() {
+        let pitch = 10f64.to_radians();
+        let pose = Isometry3::from_parts(
+            Translation3::new(0.0, 0.0, 0.45),
+            UnitQuaternion::from_euler_angles(0.0, pitch, 0.0),
+        );
+        let g = ScanGeometry {
+            angle_min: 0.0,
+            angle_increment: 0.0,
+            ..geometry()
+        };
+        let two = project(&[2.0], &g, Some(&pose));
+        let z = (pose * Point3::new(two[0].sensor.x, two[0].sensor.y, 0.0)).z;
+        assert!((z - (0.45 - 2.0 * pitch.sin())).abs() < 1e-12, "{z}");
+        assert!((0.45 / pitch.sin() - 2.591).abs() < 1e-3);
+        let three = project(&[3.0], &g, Some(&pose));
+        let sides = project(&[3.0, 3.0, 3.0], &geometry(), Some(&pose));
+        assert_eq!(above_ground(&two, &pose, 0.1), (two.clone(), 0));
+        assert_eq!(above_ground(&three, &pose, 0.1), (vec![], 1));
+        let (kept, dropped) = above_ground(&sides, &pose, 0.1);
+        assert_eq!(dropped, 1, "{kept:?}");
+        assert_eq!(kept.iter().map(|q| q.beam).collect::<Vec<_>>(), vec![0, 2]);
     }
 
     #[test]

@@ -41,6 +41,7 @@ fn step(tr: &mut FollowTracker, t: f64, world: &[(f64, f64, f64)]) -> StepOutput
         t,
         points: &pts,
         omni: None,
+        laser_pose: None,
     })
     .expect("step")
 }

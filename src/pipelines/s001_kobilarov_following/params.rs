@@ -144,6 +144,9 @@ pub struct Variant {
     /// The other people tracked, their blobs discounted (our addition,
     /// `laser::follow::others`).
     pub others: bool,
+    /// Ground hits make no blob (`laser::follow::FollowParams::ground_below_m` at
+    /// [`GROUND_BELOW_M`]; our reading of §VI).
+    pub ground: bool,
 }
 
 impl Variant {
@@ -156,6 +159,7 @@ impl Variant {
         printed: false,
         literal_rst: false,
         colour_watch: false,
+        ground: false,
         others: false,
     };
 }
@@ -183,18 +187,25 @@ pub const WATCH: &str = "ct_colour_watch";
 /// Our addition: the paper's configuration with the other people tracked
 /// (`laser::follow::others`).
 pub const OTHERS: &str = "ct_colour_others";
+/// Our reading of §VI ("no valid measurements of the human" while the laser sees the ground)
+/// on top of the colour watchdog: returns below [`GROUND_BELOW_M`] make no blob.
+pub const WATCH_GROUND: &str = "ct_colour_watch_ground";
+/// The ground's height in `odom` (m): the platform check's `synth::follow::avoid::GROUND_Z_M`,
+/// a priori.
+pub const GROUND_BELOW_M: f64 = 0.1;
 pub const CV: &str = "cv_colour";
 pub const IMM: &str = "imm_colour";
 pub const NO_COLOUR: &str = "ct_no_colour";
 pub const NN: &str = "nn_ct";
 pub const LASER_TRACKER: &str = "laser_tracker";
 /// Every known method, in the default table order.
-pub const METHODS: [&str; 11] = [
+pub const METHODS: [&str; 12] = [
     PAPER,
     UPDATED,
     PRINTED,
     RST5,
     WATCH,
+    WATCH_GROUND,
     OTHERS,
     CV,
     IMM,
@@ -218,6 +229,11 @@ pub fn method(name: &str) -> Option<Method> {
         },
         WATCH => Variant {
             colour_watch: true,
+            ..p
+        },
+        WATCH_GROUND => Variant {
+            colour_watch: true,
+            ground: true,
             ..p
         },
         OTHERS => Variant { others: true, ..p },

@@ -94,6 +94,7 @@ pub(super) fn process(
                         t,
                         points: &pts,
                         omni: None,
+                        laser_pose: None,
                     },
                     f.scan.ranges.len(),
                     None,

@@ -44,6 +44,9 @@ impl Runner {
                 if v.colour_watch {
                     fp.colour_watch_s = Some(p.colour_watch_s);
                 }
+                if v.ground {
+                    fp.ground_below_m = Some(super::params::GROUND_BELOW_M);
+                }
                 if v.others {
                     fp.others = Some(crate::laser::follow::others::OthersParams::default());
                 }

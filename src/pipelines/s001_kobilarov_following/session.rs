@@ -295,6 +295,7 @@ fn step_all(
                 camera_from_fixed,
                 ctx.model.as_ref(),
             ),
+            laser_pose: Some(pose),
         };
         let out = r
             .step(&obs, f.scan.ranges.len(), Some(pose))

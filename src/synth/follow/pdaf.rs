@@ -40,6 +40,7 @@ impl Follower for PdafFollower {
             t: input.t,
             points: &pts,
             omni,
+            laser_pose: Some(&input.laser_pose),
         };
         match self.tracker.step(&obs) {
             Ok(out) => FollowerOutput {
