@@ -595,7 +595,9 @@ impl FollowTracker {
     /// Process one scan (see the module doc).
     pub fn step(&mut self, obs: &ScanObs<'_>) -> Result<StepOutput, FilterError> {
         let bl = match (self.params.ground_below_m, obs.laser_pose) {
-            (Some(z), Some(pose)) => blobs(&points::above_ground(obs.points, pose, z).0, &self.params),
+            (Some(z), Some(pose)) => {
+                blobs(&points::above_ground(obs.points, pose, z).0, &self.params)
+            }
             _ => blobs(obs.points, &self.params),
         };
         let hists = self.histograms(&bl, obs.omni.as_ref());
