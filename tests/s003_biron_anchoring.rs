@@ -92,6 +92,18 @@ fn biron_pipeline_end_to_end_on_a_short_session() {
     // the replay reproduces the closed loop's logged attention at every step
     let replay = rows(&o1, "replay");
     assert_eq!(replay.len(), 1);
+    let stem = std::fs::read_dir(&data)
+        .expect("data folder")
+        .filter_map(|e| {
+            let p = e.ok()?.path();
+            (p.extension()? == "mcap").then(|| p.file_stem()?.to_str().map(str::to_string))?
+        })
+        .next()
+        .expect("one log");
+    assert_eq!(
+        replay[0]["session"], stem,
+        "the replay row names its session"
+    );
     let steps = num(&replay[0], "steps");
     assert!(steps >= 140.0, "{replay:?}");
     assert_eq!(num(&replay[0], "mode_agree"), steps, "{replay:?}");

@@ -101,6 +101,29 @@ table_row! {
 }
 
 table_row! {
+    /// One session's replay against its logged `/attention/state`: `replay`.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct SessionReplay {
+        pub session: String,
+        pub steps: i64,
+        pub logged: i64,
+        pub mode_agree: i64,
+        pub focus_agree: i64,
+    }
+}
+
+table_row! {
+    /// One session's skipped messages on one topic: `skipped_messages`.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct SessionSkip {
+        pub session: String,
+        pub topic: String,
+        pub count: i64,
+        pub first_error: String,
+    }
+}
+
+table_row! {
     /// A paired t-test of an ablation against the full system across sessions: `paired_ttests`.
     #[derive(Debug, Clone, PartialEq)]
     pub struct TTestRow {
@@ -371,21 +394,48 @@ pub fn products(data: &[SessionData], p: &Params) -> anyhow::Result<Products> {
         .with_note("Targets (full system): speaker identification >= 0.95, focus right >= 0.90 of 100 ms steps, MOTA >= 0.8. Ablations: without sound speaker identification collapses, without faces no top-down start, without legs MOTA degrades."));
     let tt = ttests(data, p);
     out.tables.push(Table::new("paired_ttests", "Paired t-tests across sessions: each ablation against the full system (Holm over all rows)", TTestRow::frame(&tt)?));
-    let replay: Vec<ReplayRow> = data.iter().flat_map(|s| s.replay.clone()).collect();
+    let (replay, skips) = per_session_checks(data);
     out.tables.push(Table::new(
         "replay",
         "Replay of the full system against the logged /attention/state (per session)",
-        ReplayRow::frame(&replay)?,
+        SessionReplay::frame(&replay)?,
     ));
-    let skips: Vec<SkipRow> = data.iter().flat_map(|s| s.skips.clone()).collect();
     out.tables.push(Table::new(
         "skipped_messages",
-        "Messages skipped while reading",
-        SkipRow::frame(&skips)?,
+        "Messages skipped while reading (per session and topic)",
+        SessionSkip::frame(&skips)?,
     ));
     out.summary
         .extend(summary(&cells, &by_width, &by_yaw, per100, &variants));
     Ok(out)
+}
+
+/// The cached replay and skip rows of every session, each named by its session.
+pub fn per_session_checks(data: &[SessionData]) -> (Vec<SessionReplay>, Vec<SessionSkip>) {
+    let replay = data
+        .iter()
+        .flat_map(|s| {
+            s.replay.iter().map(|r: &ReplayRow| SessionReplay {
+                session: s.name.clone(),
+                steps: r.steps,
+                logged: r.logged,
+                mode_agree: r.mode_agree,
+                focus_agree: r.focus_agree,
+            })
+        })
+        .collect();
+    let skips = data
+        .iter()
+        .flat_map(|s| {
+            s.skips.iter().map(|k: &SkipRow| SessionSkip {
+                session: s.name.clone(),
+                topic: k.topic.clone(),
+                count: k.count,
+                first_error: k.first_error.clone(),
+            })
+        })
+        .collect();
+    (replay, skips)
 }
 
 fn summary(
