@@ -11,7 +11,9 @@
 //!   the IMU's pitch) and without the target's own returns (within [`TARGET_CLEAR_M`] of its
 //!   estimate) — with the earlier returns within [`MEMORY_RANGE_M`] that the laser, 0.25 m
 //!   ahead of the base with a 180° view, no longer sees (beside and behind it:
-//!   [`Surroundings`]), in the robot's planar frame; for the commanded arc, the path length before the disc grown by
+//!   [`Surroundings`]) and the places of earlier contacts (a front bumper's report, kept
+//!   within the same range whether the laser sees them or not: an obstacle whose widest
+//!   section lies below the scan plane; issue 30, round 12), in the robot's planar frame; for the commanded arc, the path length before the disc grown by
 //!   `margin_m` touches one ([`free_length`], closed form on the arc). The command stands when
 //!   that length covers its stopping distance `v²/(2·a_min)` and one scan period of travel;
 //!   else the nearest yaw rate of a fan that does, at the same
@@ -68,6 +70,9 @@ pub fn obstacle_points(input: &ScanInput<'_>, target: Option<[f64; 2]>) -> Vec<[
 #[derive(Debug, Default)]
 pub struct Surroundings {
     memory: Vec<[f64; 2]>,
+    /// Where contacts were ([`Surroundings::bump`]), kept within [`MEMORY_RANGE_M`] whether
+    /// the laser sees them or not.
+    bumps: Vec<[f64; 2]>,
 }
 
 impl Surroundings {
@@ -85,10 +90,12 @@ impl Surroundings {
         let near = |q: &[f64; 2]| (q[0] - robot.x).hypot(q[1] - robot.y) <= MEMORY_RANGE_M;
         self.memory
             .retain(|q| near(q) && (to_laser * Point3::new(q[0], q[1], z)).x <= 0.0);
+        self.bumps.retain(near);
         let (s, c) = robot.yaw.sin_cos();
         let local = scan
             .iter()
             .chain(&self.memory)
+            .chain(&self.bumps)
             .map(|q| {
                 let (dx, dy) = (q[0] - robot.x, q[1] - robot.y);
                 [c * dx + s * dy, -s * dx + c * dy]
@@ -96,6 +103,17 @@ impl Surroundings {
             .collect();
         self.memory.extend(scan.into_iter().filter(near));
         local
+    }
+}
+
+impl Surroundings {
+    /// A contact of the footprint of `radius` at `robot`: the obstacle is marked at the
+    /// footprint's front, on the heading (a front bumper's report; issue 30, round 12), and
+    /// stays among the returns the check looks at while within [`MEMORY_RANGE_M`].
+    pub fn bump(&mut self, robot: &OdomPose, radius: f64) {
+        let (s, c) = robot.yaw.sin_cos();
+        self.bumps
+            .push([robot.x + radius * c, robot.y + radius * s]);
     }
 }
 
@@ -323,6 +341,47 @@ mod tests {
         }
         // 2.5 m on, the trunk point is out of range
         assert_eq!(s.around(vec![], &laser(3.3), &at(3.3)).len(), 0);
+    }
+
+    #[test]
+    fn a_contact_is_remembered_where_the_laser_looks_and_turns_the_robot_away() {
+        let robot = OdomPose {
+            x: 1.0,
+            y: 2.0,
+            yaw: std::f64::consts::FRAC_PI_2,
+            v: 0.0,
+        };
+        // the laser 0.25 m ahead of the base (+y here), level
+        let laser = |r: &OdomPose| {
+            Isometry3::from_parts(
+                nalgebra::Translation3::new(r.x, r.y + 0.25, 0.45),
+                nalgebra::UnitQuaternion::from_euler_angles(0.0, 0.0, r.yaw),
+            )
+        };
+        let p = Platform::default();
+        let mut s = Surroundings::default();
+        s.bump(&robot, p.radius_m);
+        // in the robot's frame the bump is the footprint's front, though the laser looks there
+        // and sees nothing; scan after scan it stays
+        for _ in 0..3 {
+            let got = s.around(vec![], &laser(&robot), &robot);
+            assert_eq!(got.len(), 1, "{got:?}");
+            assert!((got[0][0] - 0.35).abs() < 1e-12 && got[0][1].abs() < 1e-12);
+        }
+        // it blocks every arc ahead: a command to drive becomes a turn in place, at least half
+        // the turn-rate limit, towards the command's turn (the bump is dead ahead)
+        let cmd = Command {
+            v: 2.0,
+            w: 0.2,
+            desired_distance: 4.6,
+        };
+        let points = s.around(vec![], &laser(&robot), &robot);
+        let (got, changed) = apply(cmd, &points, &lim(), &p);
+        assert!(changed);
+        assert_eq!((got.v, got.w), (0.0, 0.5 * lim().max_turn_rate));
+        // 2 m away it is forgotten
+        let away = OdomPose { y: -0.1, ..robot };
+        assert_eq!(s.around(vec![], &laser(&away), &away).len(), 0);
     }
 
     #[test]

@@ -223,6 +223,9 @@ pub fn run<S: Sensors>(
                     let plain = command(spec.controller, &robot, &output, &mut trail, &lim);
                     let avoided;
                     (cmd, avoided) = if f.platform.avoid {
+                        if contact {
+                            around.bump(&robot, f.platform.radius_m);
+                        }
                         let target = output.estimate.map(|e| e.position);
                         let scan = avoid::obstacle_points(&input, target);
                         let points = around.around(scan, &input.laser_pose, &robot);

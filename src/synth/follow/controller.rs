@@ -7,7 +7,9 @@
 //! - [`pursuit`]: pure pursuit on the person's estimated path: aim at the first trail point at
 //!   least [`LOOKAHEAD_M`] away, `ω = κ·v` with the curvature `κ = 2·y/L²` of the arc through
 //!   it (`y` its lateral offset, `L` its distance); drive to null the error of the distance
-//!   *along the path* to the target (the straight range once that is below `d`).
+//!   *along the path* to the target (the straight range once that is below `d`), no faster
+//!   than the arc is drivable at the turn-rate limit (`v ≤ ω_max/|κ|`; a goal beside or
+//!   behind is turned to at `v ≤ ω_max·L/2`; issue 30, round 12).
 //!
 //! Both keep the desired following distance `d = d_follow + v²/(2·a_min)` (`v` the robot's
 //! speed, `a_min` its largest deceleration: the term seed 001's `E_follow` subtracts, so the
@@ -127,6 +129,17 @@ pub fn pursuit_curvature(x: f64, y: f64) -> f64 {
     if l2 > 0.0 { 2.0 * y / l2 } else { 0.0 }
 }
 
+/// The highest speed at which the arc of curvature `k` (1/m) is drivable at the turn-rate
+/// limit, `ω_max / |k|` (seed 001 §VI: the controllers "account for the dynamic and kinematic
+/// constraints of the robot"); unbounded on a straight line.
+pub fn drivable_speed(k: f64, lim: &Limits) -> f64 {
+    if k == 0.0 {
+        f64::INFINITY
+    } else {
+        lim.max_turn_rate / k.abs()
+    }
+}
+
 /// The person's estimated path: past estimates at least [`TRAIL_SPACING_M`] apart, and how
 /// far along it the robot has come.
 #[derive(Debug, Clone, Default)]
@@ -205,11 +218,15 @@ pub fn pursuit(robot: &OdomPose, est: &Estimate, trail: &Trail, lim: &Limits) ->
     let bearing = y.atan2(x);
     let speed_t = est.velocity[0].hypot(est.velocity[1]);
     let v = ((K_RANGE * gap + speed_t) * heading_factor(bearing)).clamp(0.0, lim.max_speed);
-    let w = if x > 0.0 {
-        pursuit_curvature(x, y) * v.max(PURSUIT_MIN_TURN_SPEED)
+    let (v, w) = if x > 0.0 {
+        let k = pursuit_curvature(x, y);
+        let v = v.min(drivable_speed(k, lim));
+        (v, k * v.max(PURSUIT_MIN_TURN_SPEED))
     } else {
-        // the goal is beside or behind: turn towards it as fast as allowed
-        lim.max_turn_rate * if y >= 0.0 { 1.0 } else { -1.0 }
+        // the goal is beside or behind: turn towards it as fast as allowed, on a circle no
+        // wider than its distance
+        let v = v.min(lim.max_turn_rate * x.hypot(y) / 2.0);
+        (v, lim.max_turn_rate * if y >= 0.0 { 1.0 } else { -1.0 })
     };
     Command {
         v,

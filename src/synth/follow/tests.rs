@@ -127,6 +127,39 @@ fn pursuit_aims_along_the_trail_not_at_the_target() {
     assert!(controller::direct(&robot, &est, &lim).w < 0.0);
 }
 
+#[test]
+fn pursuit_drives_no_faster_than_its_arc_allows_at_the_turn_rate_limit() {
+    // the goal (the only trail point, 1.03 m off) lies on an arc of curvature
+    // 2·0.9/(0.5² + 0.9²) = 1.698 /m; the target is far along the path, so the range term
+    // alone would command the speed limit (2.4 m/s), on which the arc needs 4.1 rad/s: the
+    // speed is cut to ω_max/κ and the turn is the limit, so the robot drives the arc
+    let lim = limits();
+    let robot = at_origin(1.0);
+    let mut trail = Trail::default();
+    trail.push([0.5, 0.9]);
+    trail.advance(0.0, 0.0);
+    let est = still(10.0, 10.0);
+    let c = controller::pursuit(&robot, &est, &trail, &lim);
+    let k = 2.0 * 0.9 / (0.5 * 0.5 + 0.9 * 0.9);
+    assert!((c.v - lim.max_turn_rate / k).abs() < 1e-12, "v {}", c.v);
+    assert!((c.w - lim.max_turn_rate).abs() < 1e-12, "w {}", c.w);
+    assert!((c.w / c.v - k).abs() < 1e-12);
+    assert_eq!(controller::drivable_speed(0.0, &lim), f64::INFINITY);
+    assert_eq!(controller::drivable_speed(-2.0, &lim), 0.75);
+    // a goal behind (-1, -0.5), 1.118 m off: full turn to the right, on a circle no wider
+    // than that distance: v = 1.5 · 1.118 / 2
+    let mut trail = Trail::default();
+    trail.push([-1.0, -0.5]);
+    trail.advance(0.0, 0.0);
+    let c = controller::pursuit(&robot, &est, &trail, &lim);
+    assert_eq!(c.w, -lim.max_turn_rate);
+    assert!(
+        (c.v - lim.max_turn_rate * 1.25_f64.sqrt() / 2.0).abs() < 1e-12,
+        "v {}",
+        c.v
+    );
+}
+
 /// A scan of discs (centres in the laser frame, radius) from a laser at the identity pose.
 fn disc_scan(discs: &[([f64; 2], f64)]) -> (Vec<f32>, ScanGeometry) {
     let g = ScanGeometry {
