@@ -18,7 +18,10 @@
 //!   that length covers its stopping distance `v²/(2·a_min)` and one scan period of travel;
 //!   else the nearest yaw rate of a fan that does, at the same
 //!   speed; else the fan's arc allowing the highest speed, at that speed (its curvature kept);
-//!   else (boxed in) a turn in place away from what blocks it ([`turn_away`]). A
+//!   else — boxed in: no arc of the fan has `margin_m` of free path (issue 30, round 13; before,
+//!   only no arc at all, and the robot crept at a few cm/s on the least-blocked arc, held
+//!   against the obstacle while the person ran on) — a turn in place away from what blocks it
+//!   ([`turn_away`]). A
 //!   command to stand or turn in place is never changed (a disc turns in place).
 //!
 //! Written by hand: a dynamic-window style admissibility test on one scan, a few dozen lines
@@ -204,7 +207,9 @@ pub fn apply(cmd: Command, points: &[[f64; 2]], lim: &Limits, p: &Platform) -> (
         return (cmd, false);
     }
     let need = needed(cmd.v, lim);
-    let free = |w: f64| free_length(points, w / cmd.v, p.radius_m, p.margin_m, need);
+    // capped at no less than the margin, so a slow command's arcs can be told from a box
+    let cap = need.max(p.margin_m);
+    let free = |w: f64| free_length(points, w / cmd.v, p.radius_m, p.margin_m, cap);
     if free(cmd.w) >= need {
         return (cmd, false);
     }
@@ -226,7 +231,8 @@ pub fn apply(cmd: Command, points: &[[f64; 2]], lim: &Limits, p: &Platform) -> (
         .map(|&f| speed_for(f, lim).min(cmd.v))
         .collect();
     let best = speeds.iter().copied().fold(0.0, f64::max);
-    if best <= 1e-3 {
+    let most_free = frees.iter().copied().fold(0.0, f64::max);
+    if best <= 1e-3 || most_free < p.margin_m {
         return (
             Command {
                 v: 0.0,
@@ -455,12 +461,28 @@ mod tests {
         let free = free_length(&ring, got.w / got.v, p.radius_m, p.margin_m, 10.0);
         assert!(got.v > 0.0 && got.v < 3.0, "{got:?}");
         assert!((needed(got.v, &lim()) - free).abs() < 1e-9);
-        // inside the margin the footprint alone counts: a crawl, at least what the straight
-        // arc's 0.1 m allows
+        // a ring 0.75 m round: 0.25 m of free path straight on (more than the margin), more
+        // on the curved arcs; it slows to what the freest arc allows
+        let mid: Vec<[f64; 2]> = ring.iter().map(|q| [q[0] * 0.5, q[1] * 0.5]).collect();
+        let (got, _) = apply(cmd, &mid, &lim(), &p);
+        let free = free_length(&mid, got.w / got.v, p.radius_m, p.margin_m, 10.0);
+        assert!(got.v >= speed_for(0.25, &lim()) - 1e-12, "{got:?}");
+        assert!((needed(got.v, &lim()) - free).abs() < 1e-9, "{got:?} {free}");
+        // inside the margin the footprint alone counts, and no arc has the margin's 0.15 m
+        // free: boxed in, it turns in place rather than creeping against the ring
         let near: Vec<[f64; 2]> = ring.iter().map(|q| [q[0] * 0.3, q[1] * 0.3]).collect();
         let (got, _) = apply(cmd, &near, &lim(), &p);
-        let crawl = 1.4 * (-0.1 + (0.01_f64 + 2.0 * 0.1 / 1.4).sqrt());
-        assert!(got.v >= crawl - 1e-12 && got.v < 1.01 * crawl, "{got:?}");
+        assert_eq!((got.v, got.w.abs()), (0.0, 0.75), "{got:?}");
+        // a trunk of 0.15 m radius just ahead and a little left: 0.1 m to it straight on, and
+        // no arc of the fan clears the margin; turn in place, right, away from it
+        let trunk: Vec<[f64; 2]> = (0..36)
+            .map(|i| {
+                let a = i as f64 * 10f64.to_radians();
+                [0.60 + 0.15 * a.cos(), 0.05 + 0.15 * a.sin()]
+            })
+            .collect();
+        let (got, _) = apply(cmd, &trunk, &lim(), &p);
+        assert_eq!((got.v, got.w), (0.0, -0.75), "{got:?}");
         // touching ahead: stop and turn in place away from the touch, left when balanced
         let (got, _) = apply(cmd, &[[0.3, 0.1]], &lim(), &p);
         assert_eq!((got.v, got.w), (0.0, -0.75));
