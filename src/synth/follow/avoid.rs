@@ -467,7 +467,10 @@ mod tests {
         let (got, _) = apply(cmd, &mid, &lim(), &p);
         let free = free_length(&mid, got.w / got.v, p.radius_m, p.margin_m, 10.0);
         assert!(got.v >= speed_for(0.25, &lim()) - 1e-12, "{got:?}");
-        assert!((needed(got.v, &lim()) - free).abs() < 1e-9, "{got:?} {free}");
+        assert!(
+            (needed(got.v, &lim()) - free).abs() < 1e-9,
+            "{got:?} {free}"
+        );
         // inside the margin the footprint alone counts, and no arc has the margin's 0.15 m
         // free: boxed in, it turns in place rather than creeping against the ring
         let near: Vec<[f64; 2]> = ring.iter().map(|q| [q[0] * 0.3, q[1] * 0.3]).collect();
