@@ -343,6 +343,7 @@ mod tests {
                 estimator: Default::default(),
                 pdaf: Default::default(),
                 platform: Default::default(),
+                lost: Default::default(),
             }),
             tour: None,
             odom_noise: [0.0, 0.0],

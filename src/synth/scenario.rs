@@ -16,7 +16,7 @@ mod follow;
 mod validate;
 pub use biron::BironSpec;
 use follow::follow_problem;
-pub use follow::{Controller, Estimator, Follow, Platform};
+pub use follow::{Controller, Estimator, Follow, Lost, Platform};
 
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {

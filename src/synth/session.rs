@@ -32,9 +32,10 @@ use types::{Clock, Session};
 /// log again when it differs. The counter in brackets is bumped by hand whenever a change
 /// alters what a render writes — the closed loops' estimators (`laser::follow`,
 /// `anchoring`) included, since they drive the robot while rendering. (2): issue 33's
-/// round 7 changed the BIRON loop; (1) was never bumped before that.
+/// round 7 changed the BIRON loop; (1) was never bumped before that. (3): issue 30 round 14
+/// judges a braking robot's stop by its braking arc (`synth::follow::avoid`).
 pub const GENERATOR_VERSION: &str =
-    concat!("peopletrack-synth ", env!("CARGO_PKG_VERSION"), " (2)");
+    concat!("peopletrack-synth ", env!("CARGO_PKG_VERSION"), " (3)");
 
 /// Epoch of session 0 (s); each session starts 10 000 s later.
 const EPOCH_S: u64 = 1_700_000_000;

@@ -22,7 +22,13 @@
 //!   only no arc at all, and the robot crept at a few cm/s on the least-blocked arc, held
 //!   against the obstacle while the person ran on) — a turn in place away from what blocks it
 //!   ([`turn_away`]). A
-//!   command to stand or turn in place is never changed (a disc turns in place).
+//!   command to stand or turn in place is never changed (a disc turns in place) — unless the
+//!   robot is still moving: a command slower than the robot's measured speed (a stop
+//!   included) is judged at the speed the robot has, since it brakes along the commanded
+//!   yaw rate's arc for its whole stopping distance; when no arc of the fan is clear for that
+//!   distance, it brakes along the freest one (issue 30, round 14: before, a lost robot's stop
+//!   turning towards the last prediction was never checked and braked into the trunk that
+//!   had hidden the person).
 //!
 //! Written by hand: a dynamic-window style admissibility test on one scan, a few dozen lines
 //! with no crate that fits (navigation stacks are frameworks, not functions).
@@ -36,6 +42,8 @@ use nalgebra::{Isometry3, Point3};
 pub const GROUND_Z_M: f64 = 0.1;
 /// Returns within this distance of the target's estimate (m) are the target.
 pub const TARGET_CLEAR_M: f64 = 0.6;
+/// Below this measured speed (m/s) the robot stands: a stop is not checked (odometry noise).
+pub const STANDING_MPS: f64 = 0.1;
 /// One scan period (s): the command holds until the next scan.
 pub const REACTION_S: f64 = 0.1;
 /// Yaw rates in the fan, spread evenly over `±max_turn_rate`.
@@ -201,15 +209,25 @@ fn turn_away(w_cmd: f64, points: &[[f64; 2]], p: &Platform, lim: &Limits) -> f64
     if left { w } else { -w }
 }
 
-/// The checked command and whether the check changed it (see the module doc).
-pub fn apply(cmd: Command, points: &[[f64; 2]], lim: &Limits, p: &Platform) -> (Command, bool) {
-    if !p.avoid || cmd.v <= 0.0 || points.is_empty() {
+/// The checked command and whether the check changed it (see the module doc). `v_now`: the
+/// robot's measured forward speed.
+pub fn apply(
+    cmd: Command,
+    v_now: f64,
+    points: &[[f64; 2]],
+    lim: &Limits,
+    p: &Platform,
+) -> (Command, bool) {
+    // the speed the arc is travelled at: the command's, or the robot's while it brakes
+    let braking = v_now > cmd.v && v_now >= STANDING_MPS;
+    let u = if braking { v_now } else { cmd.v };
+    if !p.avoid || u <= 0.0 || points.is_empty() {
         return (cmd, false);
     }
-    let need = needed(cmd.v, lim);
+    let need = needed(u, lim);
     // capped at no less than the margin, so a slow command's arcs can be told from a box
     let cap = need.max(p.margin_m);
-    let free = |w: f64| free_length(points, w / cmd.v, p.radius_m, p.margin_m, cap);
+    let free = |w: f64| free_length(points, w / u, p.radius_m, p.margin_m, cap);
     if free(cmd.w) >= need {
         return (cmd, false);
     }
@@ -232,11 +250,23 @@ pub fn apply(cmd: Command, points: &[[f64; 2]], lim: &Limits, p: &Platform) -> (
         .collect();
     let best = speeds.iter().copied().fold(0.0, f64::max);
     let most_free = frees.iter().copied().fold(0.0, f64::max);
-    if best <= 1e-3 || most_free < p.margin_m {
+    if most_free < p.margin_m || (!braking && best <= 1e-3) {
         return (
             Command {
                 v: 0.0,
                 w: turn_away(cmd.w, points, p, lim),
+                ..cmd
+            },
+            true,
+        );
+    }
+    if braking {
+        // it cannot stop sooner: brake along the arc with the most room
+        let i = closest(&|i| frees[i] >= most_free).expect("the most room is one of them");
+        return (
+            Command {
+                v: speeds[i],
+                w: fan[i],
                 ..cmd
             },
             true,
@@ -382,7 +412,7 @@ mod tests {
             desired_distance: 4.6,
         };
         let points = s.around(vec![], &laser(&robot), &robot);
-        let (got, changed) = apply(cmd, &points, &lim(), &p);
+        let (got, changed) = apply(cmd, 0.0, &points, &lim(), &p);
         assert!(changed);
         assert_eq!((got.v, got.w), (0.0, 0.5 * lim().max_turn_rate));
         // 2 m away it is forgotten
@@ -398,18 +428,83 @@ mod tests {
             desired_distance: 4.6,
         };
         let far = [[20.0, 0.0], [0.0, 5.0]];
-        assert_eq!(apply(cmd, &far, &lim(), &Platform::default()), (cmd, false));
+        assert_eq!(
+            apply(cmd, 0.0, &far, &lim(), &Platform::default()),
+            (cmd, false)
+        );
         let turn = Command { v: 0.0, ..cmd };
         let wall = [[0.5, 0.0]];
         assert_eq!(
-            apply(turn, &wall, &lim(), &Platform::default()),
+            apply(turn, 0.0, &wall, &lim(), &Platform::default()),
             (turn, false)
         );
         let off = Platform {
             avoid: false,
             ..Platform::default()
         };
-        assert_eq!(apply(cmd, &wall, &lim(), &off), (cmd, false));
+        assert_eq!(apply(cmd, 0.0, &wall, &lim(), &off), (cmd, false));
+    }
+
+    /// A trunk on the right, clear of the straight path: a stop turning right at 0.73 rad/s
+    /// from 2.5 m/s brakes along the arc of curvature −0.73/2.5 for 2.5²/2.8 + 0.25 m and
+    /// meets it at 2.2 m; the check turns the braking onto the nearest clear yaw rate of the
+    /// fan, still a stop. Standing (below 0.1 m/s), the same stop is not checked.
+    #[test]
+    fn a_stop_at_speed_is_judged_along_its_braking_arc() {
+        let p = Platform::default();
+        let stop = Command {
+            v: 0.0,
+            w: -0.73,
+            desired_distance: 3.2,
+        };
+        let (u, k): (f64, f64) = (2.5, -0.73 / 2.5);
+        let (rho, theta) = (-1.0 / k, 2.2 * -k);
+        let centre = [rho * theta.sin(), -rho * (1.0 - theta.cos())];
+        let trunk: Vec<[f64; 2]> = (0..36)
+            .map(|i| {
+                let a = i as f64 * 10f64.to_radians();
+                [centre[0] + 0.15 * a.cos(), centre[1] + 0.15 * a.sin()]
+            })
+            .collect();
+        let (r, m) = (p.radius_m, p.margin_m);
+        let need = u * u / 2.8 + u * REACTION_S;
+        assert!(free_length(&trunk, k, r, m, 10.0) < need);
+        assert!(free_length(&trunk, 0.0, r, m, 10.0) >= need);
+        let (got, changed) = apply(stop, u, &trunk, &lim(), &p);
+        assert!(changed);
+        assert_eq!(got.v, 0.0);
+        assert!(free_length(&trunk, got.w / u, r, m, 10.0) >= need);
+        // every yaw rate of the fan nearer the command's is blocked
+        let fan = (0..FAN).map(|i| 1.5 * (2.0 * i as f64 / (FAN - 1) as f64 - 1.0));
+        for w in fan.filter(|w| (w - stop.w).abs() < (got.w - stop.w).abs() - 1e-12) {
+            assert!(free_length(&trunk, w / u, r, m, 10.0) < need, "{w}");
+        }
+        assert_eq!(apply(stop, 0.05, &trunk, &lim(), &p), (stop, false));
+        // slowing from 2.5 to 1 m/s is judged at 2.5 m/s too (at its own 1 m/s it would
+        // stand: the tighter arc passes inside the trunk)
+        let slow = Command { v: 1.0, ..stop };
+        assert!(free_length(&trunk, slow.w / slow.v, r, m, 10.0) >= needed(1.0, &lim()));
+        let (got, _) = apply(slow, u, &trunk, &lim(), &p);
+        assert!(
+            free_length(&trunk, got.w / u, r, m, 10.0) >= need,
+            "{got:?}"
+        );
+        // nothing clear for the braking distance (a ring 1.5 m round): it brakes along the
+        // arc with the most room, still a stop
+        let ring: Vec<[f64; 2]> = (0..72)
+            .map(|i| {
+                let a = i as f64 * 5f64.to_radians();
+                [1.5 * a.cos(), 1.5 * a.sin()]
+            })
+            .collect();
+        let (got, changed) = apply(stop, u, &ring, &lim(), &p);
+        assert!(changed);
+        assert_eq!(got.v, 0.0);
+        let most = (0..FAN)
+            .map(|i| 1.5 * (2.0 * i as f64 / (FAN - 1) as f64 - 1.0))
+            .map(|w| free_length(&ring, w / u, r, m, need))
+            .fold(0.0, f64::max);
+        assert_eq!(free_length(&ring, got.w / u, r, m, need), most);
     }
 
     #[test]
@@ -430,7 +525,7 @@ mod tests {
         let need = 4.0 / 2.8 + 0.2;
         let (r, m) = (p.radius_m, p.margin_m);
         assert!(free_length(&bush, 0.0, r, m, 10.0) < need);
-        let (got, changed) = apply(cmd, &bush, &lim(), &p);
+        let (got, changed) = apply(cmd, 0.0, &bush, &lim(), &p);
         assert!(changed);
         assert_eq!(got.v, cmd.v);
         // the nearest yaw rate of the fan that is clear, and it turns away (right)
@@ -456,7 +551,7 @@ mod tests {
                 [1.5 * a.cos(), 1.5 * a.sin()]
             })
             .collect();
-        let (got, changed) = apply(cmd, &ring, &lim(), &p);
+        let (got, changed) = apply(cmd, 0.0, &ring, &lim(), &p);
         assert!(changed);
         let free = free_length(&ring, got.w / got.v, p.radius_m, p.margin_m, 10.0);
         assert!(got.v > 0.0 && got.v < 3.0, "{got:?}");
@@ -464,7 +559,7 @@ mod tests {
         // a ring 0.75 m round: 0.25 m of free path straight on (more than the margin), more
         // on the curved arcs; it slows to what the freest arc allows
         let mid: Vec<[f64; 2]> = ring.iter().map(|q| [q[0] * 0.5, q[1] * 0.5]).collect();
-        let (got, _) = apply(cmd, &mid, &lim(), &p);
+        let (got, _) = apply(cmd, 0.0, &mid, &lim(), &p);
         let free = free_length(&mid, got.w / got.v, p.radius_m, p.margin_m, 10.0);
         assert!(got.v >= speed_for(0.25, &lim()) - 1e-12, "{got:?}");
         assert!(
@@ -474,7 +569,7 @@ mod tests {
         // inside the margin the footprint alone counts, and no arc has the margin's 0.15 m
         // free: boxed in, it turns in place rather than creeping against the ring
         let near: Vec<[f64; 2]> = ring.iter().map(|q| [q[0] * 0.3, q[1] * 0.3]).collect();
-        let (got, _) = apply(cmd, &near, &lim(), &p);
+        let (got, _) = apply(cmd, 0.0, &near, &lim(), &p);
         assert_eq!((got.v, got.w.abs()), (0.0, 0.75), "{got:?}");
         // a trunk of 0.15 m radius just ahead and a little left: 0.1 m to it straight on, and
         // no arc of the fan clears the margin; turn in place, right, away from it
@@ -484,12 +579,12 @@ mod tests {
                 [0.60 + 0.15 * a.cos(), 0.05 + 0.15 * a.sin()]
             })
             .collect();
-        let (got, _) = apply(cmd, &trunk, &lim(), &p);
+        let (got, _) = apply(cmd, 0.0, &trunk, &lim(), &p);
         assert_eq!((got.v, got.w), (0.0, -0.75), "{got:?}");
         // touching ahead: stop and turn in place away from the touch, left when balanced
-        let (got, _) = apply(cmd, &[[0.3, 0.1]], &lim(), &p);
+        let (got, _) = apply(cmd, 0.0, &[[0.3, 0.1]], &lim(), &p);
         assert_eq!((got.v, got.w), (0.0, -0.75));
-        let (got, _) = apply(cmd, &[[0.3, 0.1], [0.3, -0.1]], &lim(), &p);
+        let (got, _) = apply(cmd, 0.0, &[[0.3, 0.1], [0.3, -0.1]], &lim(), &p);
         assert_eq!((got.v, got.w), (0.0, 0.75));
     }
 }

@@ -28,7 +28,7 @@ use crate::synth::motion::DT;
 use crate::synth::robot::{
     self, Odometer, OdometrySample, PITCH_JITTER_RAD, RobotState, RobotTrack,
 };
-use crate::synth::scenario::{Controller, Follow, Robot};
+use crate::synth::scenario::{Controller, Follow, Lost, Robot};
 use crate::synth::world::Obstacle;
 use crate::time::Nanos;
 
@@ -220,7 +220,8 @@ pub fn run<S: Sensors>(
                         yaw: pose[2],
                         v: v_odo,
                     };
-                    let plain = command(spec.controller, &robot, &output, &mut trail, &lim);
+                    let plain =
+                        command((spec.controller, f.lost), &robot, &output, &mut trail, &lim);
                     let avoided;
                     (cmd, avoided) = if f.platform.avoid {
                         if contact {
@@ -229,7 +230,7 @@ pub fn run<S: Sensors>(
                         let target = output.estimate.map(|e| e.position);
                         let scan = avoid::obstacle_points(&input, target);
                         let points = around.around(scan, &input.laser_pose, &robot);
-                        avoid::apply(plain, &points, &lim, &f.platform)
+                        avoid::apply(plain, robot.v, &points, &lim, &f.platform)
                     } else {
                         (plain, false)
                     };
@@ -275,9 +276,10 @@ pub fn blocked(obstacles: &[Obstacle], radius: f64, from: (f64, f64), to: (f64, 
         })
 }
 
-/// The controller's command for one scan's output; keeps the trail of estimates.
+/// The controller's command for one scan's output (and, while the target is lost, what
+/// `lost` says); keeps the trail of estimates.
 fn command(
-    controller: Controller,
+    (controller, lost): (Controller, Lost),
     robot: &OdomPose,
     output: &FollowerOutput,
     trail: &mut Trail,
@@ -288,7 +290,10 @@ fn command(
     }
     let Some(est) = &output.estimate else {
         trail.clear();
-        return controller::stop(robot, output.look_at, lim);
+        return match (lost, output.look_at) {
+            (Lost::Search, Some(p)) => controller::search(robot, p, lim),
+            _ => controller::stop(robot, output.look_at, lim),
+        };
     };
     trail.push(est.position);
     trail.advance(robot.x, robot.y);

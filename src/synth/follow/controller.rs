@@ -17,7 +17,9 @@
 //! applies the acceleration and deceleration limits when it tracks the commanded speed;
 //! without an estimate the command is a stop, which it reaches at `a_min`, turning towards the
 //! target's last prediction when the follower gives one ([`stop`]; seed 001 §VI: `rst` "will
-//! cause the robot to stop, and reinitiate the track").
+//! cause the robot to stop, and reinitiate the track"), or, with `lost = "search"` (our
+//! addition, issue 30, round 14), drives to that prediction and turns in place there
+//! ([`search`]).
 
 use super::Estimate;
 use crate::synth::robot::wrap;
@@ -31,6 +33,8 @@ pub const K_BEARING: f64 = 2.0;
 pub const LOOKAHEAD_M: f64 = 1.0;
 /// Smallest speed pure pursuit turns with (m/s): it still faces a target it need not approach.
 pub const PURSUIT_MIN_TURN_SPEED: f64 = 0.5;
+/// Top speed of [`search`] (m/s): Table I's mean following speed `v_avg` (a priori).
+pub const SEARCH_SPEED_MPS: f64 = 1.5;
 /// Trail points closer together than this are not kept (m).
 pub const TRAIL_SPACING_M: f64 = 0.1;
 /// A trail point the robot came this close to is passed (m).
@@ -100,6 +104,33 @@ pub fn stop(robot: &OdomPose, look_at: Option<[f64; 2]>, lim: &Limits) -> Comman
         v: 0.0,
         w,
         desired_distance: lim.desired_distance(robot.v),
+    }
+}
+
+/// Search (our addition; issue 30, round 14): drive towards `look_at`, the target's last
+/// prediction (`odom`), turning to it as [`direct`] does (`ω = K_β·β`, slowed off the nose),
+/// at `K_r·ρ` but no faster than [`SEARCH_SPEED_MPS`]; within `ρ₀` = [`TRAIL_REACHED_M`] of
+/// it (reached in finite time: the speed law aims at the point itself), turn in place at half the turn-rate limit, to the left, so the laser's
+/// 180° sweeps round the place the target was lost at. The obstacle check applies to it as to
+/// every command. Seed 001 stops instead ([`stop`]): a robot that stops behind the trunk that
+/// hid the person never sees them again (the full run's run 03, which stood for 163 s).
+pub fn search(robot: &OdomPose, look_at: [f64; 2], lim: &Limits) -> Command {
+    let desired_distance = lim.desired_distance(robot.v);
+    let (dx, dy) = (look_at[0] - robot.x, look_at[1] - robot.y);
+    let range = dx.hypot(dy);
+    if range <= TRAIL_REACHED_M {
+        return Command {
+            v: 0.0,
+            w: 0.5 * lim.max_turn_rate,
+            desired_distance,
+        };
+    }
+    let bearing = wrap(dy.atan2(dx) - robot.yaw);
+    let v = (K_RANGE * range).min(SEARCH_SPEED_MPS).min(lim.max_speed);
+    Command {
+        v: v * heading_factor(bearing),
+        w: (K_BEARING * bearing).clamp(-lim.max_turn_rate, lim.max_turn_rate),
+        desired_distance,
     }
 }
 

@@ -7,13 +7,13 @@ use nalgebra::{Isometry3, Point3};
 
 use super::avoid::Platform;
 use super::closed_loop::{self, CaptureEvent, ClosedLoop, LoopSpec, Sensed, Sensors};
-use super::controller::{self, Limits, OdomPose, Trail};
+use super::controller::{self, Limits, OdomPose, SEARCH_SPEED_MPS, TRAIL_REACHED_M, Trail};
 use super::nearest_blob::{LOST_AFTER_S, NearestBlobFollower};
 use super::{Estimate, Follower, FollowerOutput, ScanInput};
 use crate::laser::points::ScanGeometry;
 use crate::synth::motion::DT;
 use crate::synth::robot;
-use crate::synth::scenario::{Controller, Estimator, Follow, Robot, RobotMode};
+use crate::synth::scenario::{Controller, Estimator, Follow, Lost, Robot, RobotMode};
 use crate::synth::world::Obstacle;
 use crate::time::Nanos;
 
@@ -85,6 +85,27 @@ fn the_turn_has_the_sign_of_the_bearing_error() {
     // saturates at the turn-rate limit
     let c = controller::direct(&robot, &still(-3.0, 0.1), &lim);
     assert_eq!(c.w, lim.max_turn_rate);
+}
+
+/// `search`: `v = min(K_r·ρ, 1.5)·(1 − 0.6·min(|β|, 1))`, `ω = K_β·β` clamped; at
+/// the point, a turn in place at half the turn-rate limit.
+#[test]
+fn search_drives_to_the_point_at_its_top_speed_and_turns_in_place_there() {
+    let lim = limits();
+    let robot = at_origin(0.0);
+    let ahead = controller::search(&robot, [5.0, 0.0], &lim);
+    assert_eq!((ahead.v, ahead.w), (1.5, 0.0));
+    let near = controller::search(&robot, [0.8, 0.0], &lim);
+    assert!((near.v - 1.2 * 0.8).abs() < 1e-12, "{near:?}");
+    let left = controller::search(&robot, [0.0, 5.0], &lim);
+    assert!((left.v - 1.5 * 0.4).abs() < 1e-12, "{left:?}");
+    assert_eq!(left.w, lim.max_turn_rate);
+    let right = controller::search(&robot, [5.0, -0.5], &lim);
+    let beta = (-0.5f64).atan2(5.0);
+    assert!((right.w - 2.0 * beta).abs() < 1e-12);
+    assert!((right.v - 1.5 * (1.0 - 0.6 * beta.abs())).abs() < 1e-12);
+    let there = controller::search(&robot, [0.3, 0.2], &lim);
+    assert_eq!((there.v, there.w), (0.0, 0.5 * lim.max_turn_rate));
 }
 
 #[test]
@@ -259,6 +280,7 @@ fn follow_spec() -> Follow {
         estimator: Estimator::NearestBlob,
         pdaf: Default::default(),
         platform: Default::default(),
+        lost: Default::default(),
     }
 }
 
@@ -345,14 +367,24 @@ fn run_among(
     trunks: &[Obstacle],
     platform: Platform,
 ) -> ClosedLoop {
-    let robot = robot_spec();
     let follow = Follow {
         platform,
         ..follow_spec()
     };
+    run_follow(controller, follower, trunks, &follow)
+}
+
+/// [`run_among`] with the robot's whole `[robot.follow]` table.
+fn run_follow(
+    controller: Controller,
+    follower: &mut dyn Follower,
+    trunks: &[Obstacle],
+    follow: &Follow,
+) -> ClosedLoop {
+    let robot = robot_spec();
     let spec = LoopSpec {
         robot: &robot,
-        follow: &follow,
+        follow,
         controller,
         duration: 15.0,
         seed: 7,
@@ -496,6 +528,47 @@ fn a_lost_target_turns_the_stopped_robot_towards_its_last_prediction() {
             .all(|s| s.command.w.abs() <= lim.max_turn_rate)
     );
     assert!(run.scans.iter().any(|s| s.t > lost_at && s.command.w > 0.5));
+}
+
+/// With `lost = "search"` the lost robot drives to the last prediction instead of stopping,
+/// and turns in place once there (our addition; issue 30, round 14).
+#[test]
+fn a_searching_robot_drives_to_the_last_prediction_and_turns_there() {
+    let look = [6.0, 5.0];
+    let follow = Follow {
+        lost: Lost::Search,
+        ..follow_spec()
+    };
+    let mut lose = LosesAt {
+        lost_at: 3.0,
+        look: Some(look),
+    };
+    let run = run_follow(Controller::Direct, &mut lose, &[], &follow);
+    // where odometry puts it (the look point is in `odom`)
+    let last = run.scans.last().expect("scans");
+    let left = (look[0] - last.robot[0]).hypot(look[1] - last.robot[1]);
+    assert!(
+        left <= TRAIL_REACHED_M,
+        "{left} m short at {:?}",
+        last.robot
+    );
+    assert_eq!(last.command.v, 0.0);
+    assert_eq!(last.command.w, 0.5 * limits().max_turn_rate);
+    let top = run
+        .scans
+        .iter()
+        .filter(|s| s.t > 3.0)
+        .map(|s| s.command.v)
+        .fold(0.0, f64::max);
+    assert!(top > 1.0 && top <= SEARCH_SPEED_MPS, "{top}");
+    // the paper's stop, for the same loss, stands where it braked
+    let mut lose = LosesAt {
+        lost_at: 3.0,
+        look: Some(look),
+    };
+    let stopped = run_follow(Controller::Direct, &mut lose, &[], &follow_spec());
+    let end = stopped.track.samples.last().expect("samples");
+    assert!((look[0] - end.x).hypot(look[1] - end.y) > 3.0, "{end:?}");
 }
 
 /// A trunk 0.2 m off the robot's straight path to a still target 20 m ahead: the footprint's

@@ -41,6 +41,9 @@ pub struct Follow {
     /// (`synth::follow::avoid`).
     #[serde(default)]
     pub platform: Platform,
+    /// What the robot does while the target is lost (`synth::follow::controller`).
+    #[serde(default)]
+    pub lost: Lost,
 }
 
 /// `[robot.follow.platform]`: the robot's footprint and its obstacle check.
@@ -101,6 +104,19 @@ impl Controller {
             Controller::Direct => "direct",
         }
     }
+}
+
+/// What the closed loop's robot does while its estimator has lost the target.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Lost {
+    /// Seed 001 §VI: `rst` "will cause the robot to stop"; it turns towards the target's
+    /// last prediction while it stands.
+    #[default]
+    Stop,
+    /// Our addition (issue 30, round 14): drive to the last prediction, then turn in place
+    /// there (`synth::follow::controller::search`).
+    Search,
 }
 
 /// The estimator of the target that the closed loop follows.
