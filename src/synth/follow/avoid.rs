@@ -21,7 +21,7 @@
 //!   else — boxed in: no arc of the fan has `margin_m` of free path (issue 30, round 13; before,
 //!   only no arc at all, and the robot crept at a few cm/s on the least-blocked arc, held
 //!   against the obstacle while the person ran on) — a turn in place away from what blocks it
-//!   ([`turn_away`]). A
+//!   ([`turn_away`]; its side held from scan to scan until the robot is free). A
 //!   command to stand or turn in place is never changed (a disc turns in place) — unless the
 //!   robot is still moving: a command slower than the robot's measured speed (a stop
 //!   included) is judged at the speed the robot has, since it brakes along the commanded
@@ -84,6 +84,8 @@ pub struct Surroundings {
     /// Where contacts were ([`Surroundings::bump`]), kept within [`MEMORY_RANGE_M`] whether
     /// the laser sees them or not.
     bumps: Vec<[f64; 2]>,
+    /// The side of the boxed-in turn at the scan before (left: true), held while boxed in.
+    boxed_left: Option<bool>,
 }
 
 impl Surroundings {
@@ -188,29 +190,56 @@ fn speed_for(free: f64, lim: &Limits) -> f64 {
     a * (-REACTION_S + (REACTION_S * REACTION_S + 2.0 * free.max(0.0) / a).sqrt())
 }
 
-/// Boxed in: the turn in place, at least half the turn-rate limit, away from the side the
-/// blocking returns (ahead, within the grown footprint) lie on; towards the command's turn when
-/// they are balanced, left when that is nought too.
-fn turn_away(w_cmd: f64, points: &[[f64; 2]], p: &Platform, lim: &Limits) -> f64 {
+/// Boxed in: the turn in place, at least half the turn-rate limit, and whether it is to the
+/// left: `keep`'s side when the robot was boxed in at the scan before (issue 30, round 14: the
+/// side is held until the robot is free, since turning brings returns onto the side it turns
+/// to, and choosing afresh at each scan made a dev run's robot wobble in place for 70 s);
+/// otherwise away from the side the blocking returns (ahead, within the grown footprint) lie
+/// on; towards the command's turn when they are balanced, left when that is nought too.
+fn turn_away(
+    w_cmd: f64,
+    points: &[[f64; 2]],
+    p: &Platform,
+    lim: &Limits,
+    keep: Option<bool>,
+) -> (f64, bool) {
     let grown = p.radius_m + p.margin_m;
     let lateral: f64 = points
         .iter()
         .filter(|q| q[0] > 0.0 && q[0].hypot(q[1]) <= grown)
         .map(|q| q[1])
         .sum();
-    let left = if lateral.abs() > 1e-9 {
+    let left = keep.unwrap_or(if lateral.abs() > 1e-9 {
         lateral < 0.0
     } else if w_cmd != 0.0 {
         w_cmd > 0.0
     } else {
         true
-    };
+    });
     let w = w_cmd.abs().max(0.5 * lim.max_turn_rate);
-    if left { w } else { -w }
+    (if left { w } else { -w }, left)
 }
 
-/// The checked command and whether the check changed it (see the module doc). `v_now`: the
-/// robot's measured forward speed.
+impl Surroundings {
+    /// [`apply`], holding a boxed-in turn's side from one scan to the next until the robot is
+    /// no longer boxed in ([`turn_away`]).
+    pub fn check(
+        &mut self,
+        cmd: Command,
+        v_now: f64,
+        points: &[[f64; 2]],
+        lim: &Limits,
+        p: &Platform,
+    ) -> (Command, bool) {
+        let (out, changed, boxed) = check(cmd, v_now, points, lim, p, self.boxed_left);
+        self.boxed_left = boxed;
+        (out, changed)
+    }
+}
+
+/// The checked command and whether the check changed it (see the module doc), each scan on
+/// its own (no boxed-in side held: [`Surroundings::check`] holds it). `v_now`: the robot's
+/// measured forward speed.
 pub fn apply(
     cmd: Command,
     v_now: f64,
@@ -218,18 +247,32 @@ pub fn apply(
     lim: &Limits,
     p: &Platform,
 ) -> (Command, bool) {
+    let (out, changed, _) = check(cmd, v_now, points, lim, p, None);
+    (out, changed)
+}
+
+/// [`apply`] with the side of the boxed-in turn at the scan before (`keep`); also returns the
+/// side of this scan's boxed-in turn (`None`: not boxed in).
+fn check(
+    cmd: Command,
+    v_now: f64,
+    points: &[[f64; 2]],
+    lim: &Limits,
+    p: &Platform,
+    keep: Option<bool>,
+) -> (Command, bool, Option<bool>) {
     // the speed the arc is travelled at: the command's, or the robot's while it brakes
     let braking = v_now > cmd.v && v_now >= STANDING_MPS;
     let u = if braking { v_now } else { cmd.v };
     if !p.avoid || u <= 0.0 || points.is_empty() {
-        return (cmd, false);
+        return (cmd, false, None);
     }
     let need = needed(u, lim);
     // capped at no less than the margin, so a slow command's arcs can be told from a box
     let cap = need.max(p.margin_m);
     let free = |w: f64| free_length(points, w / u, p.radius_m, p.margin_m, cap);
     if free(cmd.w) >= need {
-        return (cmd, false);
+        return (cmd, false, None);
     }
     let fan: Vec<f64> = (0..FAN)
         .map(|i| lim.max_turn_rate * (2.0 * i as f64 / (FAN - 1) as f64 - 1.0))
@@ -241,7 +284,7 @@ pub fn apply(
             .min_by(|&a, &b| (fan[a] - cmd.w).abs().total_cmp(&(fan[b] - cmd.w).abs()))
     };
     if let Some(i) = closest(&|i| frees[i] >= need) {
-        return (Command { w: fan[i], ..cmd }, true);
+        return (Command { w: fan[i], ..cmd }, true, None);
     }
     // nothing clear at this speed: the arc allowing the highest speed, nearest the command
     let speeds: Vec<f64> = frees
@@ -251,14 +294,8 @@ pub fn apply(
     let best = speeds.iter().copied().fold(0.0, f64::max);
     let most_free = frees.iter().copied().fold(0.0, f64::max);
     if most_free < p.margin_m || (!braking && best <= 1e-3) {
-        return (
-            Command {
-                v: 0.0,
-                w: turn_away(cmd.w, points, p, lim),
-                ..cmd
-            },
-            true,
-        );
+        let (w, left) = turn_away(cmd.w, points, p, lim, keep);
+        return (Command { v: 0.0, w, ..cmd }, true, Some(left));
     }
     if braking {
         // it cannot stop sooner: brake along the arc with the most room
@@ -270,6 +307,7 @@ pub fn apply(
                 ..cmd
             },
             true,
+            None,
         );
     }
     let i = closest(&|i| speeds[i] >= best).expect("the best speed is one of them");
@@ -281,6 +319,7 @@ pub fn apply(
             ..cmd
         },
         true,
+        None,
     )
 }
 
@@ -505,6 +544,30 @@ mod tests {
             .map(|w| free_length(&ring, w / u, r, m, need))
             .fold(0.0, f64::max);
         assert_eq!(free_length(&ring, got.w / u, r, m, need), most);
+    }
+
+    /// Boxed in, the side of the turn is held while the robot stays boxed in (the returns
+    /// ahead moving to the other side as it turns would flip it), and chosen afresh once it
+    /// was free.
+    #[test]
+    fn a_boxed_in_turn_keeps_its_side_until_the_robot_is_free() {
+        let p = Platform::default();
+        let cmd = Command {
+            v: 3.0,
+            w: 0.0,
+            desired_distance: 6.4,
+        };
+        let (left, right) = ([[0.3, 0.1]], [[0.3, -0.1]]);
+        assert_eq!(apply(cmd, 0.0, &left, &lim(), &p).0.w, -0.75);
+        assert_eq!(apply(cmd, 0.0, &right, &lim(), &p).0.w, 0.75);
+        let mut s = Surroundings::default();
+        assert_eq!(s.check(cmd, 0.0, &left, &lim(), &p).0.w, -0.75);
+        // turned right, the return is now on the right: still right
+        assert_eq!(s.check(cmd, 0.0, &right, &lim(), &p).0.w, -0.75);
+        // free for a scan: the side is forgotten
+        let far = [[20.0, 0.0]];
+        assert_eq!(s.check(cmd, 0.0, &far, &lim(), &p), (cmd, false));
+        assert_eq!(s.check(cmd, 0.0, &right, &lim(), &p).0.w, 0.75);
     }
 
     #[test]

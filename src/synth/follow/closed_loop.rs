@@ -230,7 +230,7 @@ pub fn run<S: Sensors>(
                         let target = output.estimate.map(|e| e.position);
                         let scan = avoid::obstacle_points(&input, target);
                         let points = around.around(scan, &input.laser_pose, &robot);
-                        avoid::apply(plain, robot.v, &points, &lim, &f.platform)
+                        around.check(plain, robot.v, &points, &lim, &f.platform)
                     } else {
                         (plain, false)
                     };
