@@ -327,6 +327,16 @@ fn check(
 mod tests {
     use super::*;
 
+    /// Returns every 5° on a circle of `radius` round the robot.
+    fn ring(radius: f64) -> Vec<[f64; 2]> {
+        (0..72)
+            .map(|i| {
+                let a = i as f64 * 5f64.to_radians();
+                [radius * a.cos(), radius * a.sin()]
+            })
+            .collect()
+    }
+
     fn lim() -> Limits {
         Limits {
             following_distance: 3.2,
@@ -530,12 +540,7 @@ mod tests {
         );
         // nothing clear for the braking distance (a ring 1.5 m round): it brakes along the
         // arc with the most room, still a stop
-        let ring: Vec<[f64; 2]> = (0..72)
-            .map(|i| {
-                let a = i as f64 * 5f64.to_radians();
-                [1.5 * a.cos(), 1.5 * a.sin()]
-            })
-            .collect();
+        let ring = ring(1.5);
         let (got, changed) = apply(stop, u, &ring, &lim(), &p);
         assert!(changed);
         assert_eq!(got.v, 0.0);
@@ -608,12 +613,7 @@ mod tests {
             desired_distance: 6.4,
         };
         // a ring of returns 1.5 m around the robot: every arc meets it within 1 m
-        let ring: Vec<[f64; 2]> = (0..72)
-            .map(|i| {
-                let a = i as f64 * 5f64.to_radians();
-                [1.5 * a.cos(), 1.5 * a.sin()]
-            })
-            .collect();
+        let ring = ring(1.5);
         let (got, changed) = apply(cmd, 0.0, &ring, &lim(), &p);
         assert!(changed);
         let free = free_length(&ring, got.w / got.v, p.radius_m, p.margin_m, 10.0);

@@ -1,6 +1,6 @@
 //! `[robot.follow]`: the following robot's parameters — its target, following distance and
 //! limits, and the closed loop's keys (`closed_loop`, `controllers`, `max_decel`,
-//! `max_turn_rate`, `estimator`; see `synth::follow`).
+//! `max_turn_rate`, `estimator`, `pdaf`, `platform`, `lost`; see `synth::follow`).
 
 use serde::{Deserialize, Serialize};
 
