@@ -110,10 +110,12 @@ pub fn stop(robot: &OdomPose, look_at: Option<[f64; 2]>, lim: &Limits) -> Comman
 /// Search (our addition; issue 30, round 14): drive towards `look_at`, the target's last
 /// prediction (`odom`), turning to it as [`direct`] does (`ω = K_β·β`, slowed off the nose),
 /// at `K_r·ρ` but no faster than [`SEARCH_SPEED_MPS`]; within `ρ₀` = [`TRAIL_REACHED_M`] of
-/// it (reached in finite time: the speed law aims at the point itself), turn in place at half the turn-rate limit, to the left, so the laser's
-/// 180° sweeps round the place the target was lost at. The obstacle check applies to it as to
-/// every command. Seed 001 stops instead ([`stop`]): a robot that stops behind the trunk that
-/// hid the person never sees them again (the full run's run 03, which stood for 163 s).
+/// it (reached in finite time: the speed law aims at the point itself), turn in place at half
+/// the turn-rate limit, to the left, so the laser's 180° sweeps round the place the target was
+/// lost at. The obstacle check applies to it as to every command. Seed 001 stops instead
+/// ([`stop`]): a robot that stops behind the trunk that hid the person may not see them again
+/// (the second full run's run 03 stood for 163 s). Not the default: it did not gain on the
+/// dev split (docs/s001_kobilarov_following.md, round 14).
 pub fn search(robot: &OdomPose, look_at: [f64; 2], lim: &Limits) -> Command {
     let desired_distance = lim.desired_distance(robot.v);
     let (dx, dy) = (look_at[0] - robot.x, look_at[1] - robot.y);
