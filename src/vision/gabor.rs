@@ -37,11 +37,18 @@
 //! matter for the mask: `‖Bᵗ − Mᵗ‖ = (1 − α) ‖Bᵗ⁻¹ − Mᵗ‖`, and a median + k·MAD threshold is
 //! scale-invariant.
 //!
+//! [`GhostTest`] (our addition, off unless asked for; `gabor/ghosts.rs`) removes *ghosts*, the
+//! regions a person left behind in a background that held them, by comparing the luminance
+//! edges along each region's contour in the frame and in the background.
+//!
 //! What it does not do: no shadow model, no morphology on the segmentation. σ, λ and k are
 //! not given in the paper; they are parameters.
 
 use image::RgbImage;
 use rayon::prelude::*;
+
+mod ghosts;
+pub use ghosts::{GhostTest, sobel_magnitude};
 
 /// Number of filters in the bank (eq. 1): 4 orientations × (luminance + R, G, B).
 pub const FILTERS: usize = 16;
@@ -399,8 +406,10 @@ pub struct Segmentation {
     pub threshold: f64,
     pub median: f64,
     pub mad: f64,
-    /// Foreground pixels.
+    /// Foreground pixels (after ghost removal).
     pub foreground: usize,
+    /// Regions judged ghosts and learnt into the background ([`GhostTest`]).
+    pub ghosts: usize,
 }
 
 /// How the background model learns from a frame.
@@ -432,6 +441,11 @@ pub struct GaborBackground {
     current: Features,
     distance: Vec<f32>,
     scratch: Scratch,
+    /// The ghost test and, with it, the luminance of the frame and of the background.
+    ghosts: Option<GhostTest>,
+    luma: Vec<f32>,
+    luma_bg: Vec<f32>,
+    ghost_scratch: ghosts::GhostScratch,
 }
 
 impl GaborBackground {
@@ -459,7 +473,17 @@ impl GaborBackground {
             current: Features::default(),
             distance: Vec::new(),
             scratch: Scratch::default(),
+            ghosts: None,
+            luma: Vec::new(),
+            luma_bg: Vec::new(),
+            ghost_scratch: ghosts::GhostScratch::default(),
         })
+    }
+
+    /// Remove ghosts with `test` after each segmentation (our addition, [`GhostTest`]).
+    pub fn with_ghost_removal(mut self, test: GhostTest) -> GaborBackground {
+        self.ghosts = Some(test);
+        self
     }
 
     /// Use `update` instead of eq. 2's all-pixel rule.
@@ -530,6 +554,9 @@ impl GaborBackground {
         let mut model = Features::default();
         self.bank.features(&median, &mut model, &mut self.scratch)?;
         self.model = Some(model);
+        if self.ghosts.is_some() {
+            ghosts::luma(median.as_raw(), &mut self.luma_bg);
+        }
         Ok(())
     }
 
@@ -554,8 +581,16 @@ impl GaborBackground {
             *mask = Mask::new(w, h);
         }
         let n = w as usize * h as usize;
+        if self.ghosts.is_some() {
+            ghosts::luma(rgb.as_raw(), &mut self.luma);
+            if self.model.is_some() && self.luma_bg.len() != n {
+                // the test was switched on after the model started: start its luminance here
+                self.luma_bg.clone_from(&self.luma);
+            }
+        }
         let Some(model) = self.model.as_mut() else {
             self.model = Some(self.current.clone());
+            self.luma_bg.clone_from(&self.luma);
             mask.data.fill(0);
             self.distance.clear();
             self.distance.resize(n, 0.0);
@@ -568,6 +603,12 @@ impl GaborBackground {
             for (b, m) in model.planes.iter_mut().zip(&self.current.planes) {
                 b.par_iter_mut()
                     .zip(m.par_iter())
+                    .for_each(|(b, m)| *b = (1.0 - a) * *b + a * m);
+            }
+            if self.ghosts.is_some() {
+                self.luma_bg
+                    .iter_mut()
+                    .zip(&self.luma)
                     .for_each(|(b, m)| *b = (1.0 - a) * *b + a * m);
             }
         }
@@ -594,6 +635,40 @@ impl GaborBackground {
             .par_iter_mut()
             .zip(self.distance.par_iter())
             .for_each(|(m, d)| *m = u8::from(*d > t));
+        let mut ghost_count = 0;
+        if let Some(test) = self.ghosts {
+            ghost_count = ghosts::find(
+                &mask.data,
+                w as usize,
+                &self.luma,
+                &self.luma_bg,
+                test,
+                &mut self.ghost_scratch,
+            );
+            if ghost_count > 0 {
+                // the ghost's pixels become background: learnt at once, out of the mask
+                let heal = &self.ghost_scratch.heal;
+                for (b, m) in model.planes.iter_mut().zip(&self.current.planes) {
+                    for ((b, m), &g) in b.iter_mut().zip(m).zip(heal) {
+                        if g == 1 {
+                            *b = *m;
+                        }
+                    }
+                }
+                for (((b, m), k), &g) in self
+                    .luma_bg
+                    .iter_mut()
+                    .zip(&self.luma)
+                    .zip(mask.data.iter_mut())
+                    .zip(heal)
+                {
+                    if g == 1 {
+                        *b = *m;
+                        *k = 0;
+                    }
+                }
+            }
+        }
         if let Update::Selective {
             foreground_alpha,
             dilate_px,
@@ -617,12 +692,19 @@ impl GaborBackground {
                         *b = (1.0 - a) * *b + a * m;
                     });
             }
+            if self.ghosts.is_some() {
+                for ((b, m), &g) in self.luma_bg.iter_mut().zip(&self.luma).zip(grown) {
+                    let a = rates[usize::from(g)];
+                    *b = (1.0 - a) * *b + a * m;
+                }
+            }
         }
         Ok(Segmentation {
             threshold,
             median,
             mad,
             foreground: mask.count(),
+            ghosts: ghost_count,
         })
     }
 }

@@ -64,6 +64,11 @@ pub struct Params {
     pub background_update: BackgroundUpdate,
     /// Learning rate of foreground pixels under `background_update = "selective"`.
     pub foreground_alpha: f64,
+    /// Remove ghosts: a foreground region whose contour has more luminance edge in the
+    /// background than in the frame is learnt at once (`vision::gabor::GhostTest`; our addition).
+    pub ghost_removal: bool,
+    /// Half-width of the contour band of the ghost test (pixels).
+    pub ghost_band_px: u32,
     // §3 detection
     pub person_height_m: f64,
     pub template_scales: usize,
@@ -168,6 +173,8 @@ impl Default for Params {
             bootstrap_frames: 25,
             background_update: BackgroundUpdate::Selective,
             foreground_alpha: 0.0,
+            ghost_removal: false,
+            ghost_band_px: 4,
             person_height_m: 1.75,
             template_scales: 4,
             template_tilts: 4,
@@ -291,6 +298,12 @@ pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
         bad(
             "foreground_alpha",
             format!("{} is not in [0, 1)", p.foreground_alpha),
+        );
+    }
+    if p.ghost_band_px == 0 || p.ghost_band_px > 32 {
+        bad(
+            "ghost_band_px",
+            format!("{} is not in 1..=32 px", p.ghost_band_px),
         );
     }
     if !(p.mad_k >= 0.0 && p.mad_k.is_finite()) {

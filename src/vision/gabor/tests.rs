@@ -321,3 +321,102 @@ fn selective_update_leaves_no_trail_where_eq2_does() {
         );
     }
 }
+
+#[test]
+fn sobel_magnitude_of_a_ramp_is_eight_times_its_slope() {
+    // v = 0.1·x: Gx = (1 + 2 + 1)·(v(x+1) − v(x−1)) = 0.8 inside, 0.4 at the replicated
+    // borders, Gy = 0
+    let (w, h) = (6usize, 4usize);
+    let plane: Vec<f32> = (0..w * h).map(|i| 0.1 * (i % w) as f32).collect();
+    let mut g = Vec::new();
+    sobel_magnitude(&plane, w, h, &mut g);
+    for y in 0..h {
+        for x in 0..w {
+            let want = if x == 0 || x == w - 1 { 0.4 } else { 0.8 };
+            assert!(
+                (g[y * w + x] - want).abs() < 1e-5,
+                "({x}, {y}): {}",
+                g[y * w + x]
+            );
+        }
+    }
+}
+
+/// A smooth ramp background and the same with a dark square over `x0..x0 + 8`, rows 8..20.
+fn ramp_scene(x0: Option<u32>) -> RgbImage {
+    let mut o = RgbImage::from_fn(40, 30, |x, y| {
+        image::Rgb([(100 + x * 3) as u8, (90 + y * 4) as u8, 120])
+    });
+    if let Some(x0) = x0 {
+        for y in 8..20 {
+            for x in x0..x0 + 8 {
+                o.put_pixel(x, y, image::Rgb([20, 40, 220]));
+            }
+        }
+    }
+    o
+}
+
+fn selective_model(ghosts: bool) -> GaborBackground {
+    let bank = GaborBank::new(GaborParams::default()).expect("bank");
+    let update = Update::Selective {
+        foreground_alpha: 0.0,
+        dilate_px: bank.radius() as u32,
+    };
+    let m = GaborBackground::new(bank, 0.02, 3.0)
+        .expect("model")
+        .with_update(update)
+        .expect("update");
+    if ghosts {
+        m.with_ghost_removal(GhostTest { band_px: 4 })
+    } else {
+        m
+    }
+}
+
+#[test]
+fn a_person_who_left_the_first_frame_is_a_ghost_that_the_test_learns_away() {
+    // causal start with the square in the first frame; then it is gone
+    for ghosts in [false, true] {
+        let mut model = selective_model(ghosts);
+        let mut mask = Mask::default();
+        model
+            .apply(&noisy(&ramp_scene(Some(6)), 0), &mut mask)
+            .expect("first");
+        let s = model
+            .apply(&noisy(&ramp_scene(None), 1), &mut mask)
+            .expect("gone");
+        if ghosts {
+            assert_eq!(s.ghosts, 1, "{s:?}");
+            assert_eq!(s.foreground, 0, "{s:?}");
+        } else {
+            // frozen under the foreground: the ghost stays
+            assert_eq!(s.ghosts, 0);
+            assert!(s.foreground > 50, "{s:?}");
+        }
+        let later = model
+            .apply(&noisy(&ramp_scene(None), 2), &mut mask)
+            .expect("later");
+        assert_eq!(mask.get(10, 14), u8::from(!ghosts), "{later:?}");
+    }
+}
+
+#[test]
+fn a_person_who_arrives_is_not_a_ghost() {
+    let mut model = selective_model(true);
+    let mut mask = Mask::default();
+    for t in 0..3 {
+        model
+            .apply(&noisy(&ramp_scene(None), t), &mut mask)
+            .expect("empty");
+    }
+    // the same square, now in front of the background: its edge is in the frame
+    for t in 3..6 {
+        let s = model
+            .apply(&noisy(&ramp_scene(Some(22)), t), &mut mask)
+            .expect("here");
+        assert_eq!(s.ghosts, 0, "frame {t}: {s:?}");
+        assert!(s.foreground > 50, "frame {t}: {s:?}");
+        assert_eq!(mask.get(26, 14), 1);
+    }
+}

@@ -12,7 +12,7 @@ use crate::geometry::triangulate::CalibratedView;
 use crate::pipelines::s004_mohedano_multicam::tables::Error2dRow;
 use crate::track::cylinders::Object2d;
 use crate::track::graph_match::{Box2d, GraphTracker};
-use crate::vision::gabor::{GaborBackground, GaborBank, GaborParams, Mask, Update};
+use crate::vision::gabor::{GaborBackground, GaborBank, GaborParams, GhostTest, Mask, Update};
 use crate::vision::template::{self, Detection, DetectorParams, Silhouette};
 
 /// Per-camera state of the paper's image chain.
@@ -113,6 +113,11 @@ impl CameraChain {
         };
         let mut background =
             GaborBackground::new(setup.bank.clone(), p.alpha, p.mad_k)?.with_update(update)?;
+        if p.ghost_removal {
+            background = background.with_ghost_removal(GhostTest {
+                band_px: p.ghost_band_px,
+            });
+        }
         if let Some(frames) = boot
             && !frames.is_empty()
         {
