@@ -69,6 +69,8 @@ pub struct Params {
     pub ghost_removal: bool,
     /// Half-width of the contour band of the ghost test (pixels).
     pub ghost_band_px: u32,
+    /// Frames running a pixel must lie in ghost regions before it is learnt.
+    pub ghost_frames: u32,
     // §3 detection
     pub person_height_m: f64,
     pub template_scales: usize,
@@ -175,6 +177,7 @@ impl Default for Params {
             foreground_alpha: 0.0,
             ghost_removal: false,
             ghost_band_px: 4,
+            ghost_frames: 1,
             person_height_m: 1.75,
             template_scales: 4,
             template_tilts: 4,
@@ -304,6 +307,12 @@ pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
         bad(
             "ghost_band_px",
             format!("{} is not in 1..=32 px", p.ghost_band_px),
+        );
+    }
+    if p.ghost_frames == 0 || p.ghost_frames > 1000 {
+        bad(
+            "ghost_frames",
+            format!("{} is not in 1..=1000 frames", p.ghost_frames),
         );
     }
     if !(p.mad_k >= 0.0 && p.mad_k.is_finite()) {

@@ -10,8 +10,9 @@
 //! Sobel) over a band along its contour — the pixels within `band_px` of both the region and
 //! the outside — in the current frame and in a luminance background kept beside the features
 //! with the same update; a region whose band has more gradient in the background than in the
-//! frame is a ghost: its pixels are cleared from the mask and the model there is replaced by
-//! the current frame. The comparison has no threshold of its own (more edge in the one image
+//! frame is a ghost. Once a pixel has lain in ghost regions for `frames` frames running (a
+//! ghost stands still; a wrong verdict on a walking person moves with them), it is cleared
+//! from the mask and the model there is replaced by the current frame. The comparison has no threshold of its own (more edge in the one image
 //! than in the other); the band follows from the Gabor envelope, which spreads a silhouette
 //! by about σ, so the edge lies within about 2σ of the mask's contour.
 //!
@@ -32,6 +33,9 @@ use crate::vision::blobs::{self, Connectivity};
 pub struct GhostTest {
     /// Half-width of the contour band (pixels).
     pub band_px: u32,
+    /// A pixel is learnt once it has lain in a ghost region this many frames running
+    /// (1: at the first verdict).
+    pub frames: u32,
 }
 
 /// Scratch of the test, reused between frames; `heal` holds the last frame's ghost pixels.
@@ -44,7 +48,9 @@ pub(super) struct GhostScratch {
     near_outside: Vec<u8>,
     rows: Vec<u8>,
     labels: Vec<u32>,
-    /// 1 where a ghost region (grown by the band) lies.
+    /// Frames running each pixel has lain in a ghost region.
+    age: Vec<u32>,
+    /// 1 where a ghost region (grown by the band) has lain `frames` frames running.
     pub heal: Vec<u8>,
 }
 
@@ -80,8 +86,8 @@ pub fn sobel_magnitude(plane: &[f32], w: usize, h: usize, out: &mut Vec<f32>) {
 }
 
 /// Judge every region of `mask` (0/1, `w` wide) with the luminance of the frame (`cur`) and of
-/// the background (`bg`); `s.heal` marks the ghost regions grown by the band. Returns how
-/// many regions were ghosts.
+/// the background (`bg`); `s.heal` marks the pixels of ghost regions (grown by the band) that
+/// have been in one for `test.frames` frames running. Returns how many regions were ghosts.
 pub(super) fn find(
     mask: &[u8],
     w: usize,
@@ -93,7 +99,9 @@ pub(super) fn find(
     let n = mask.len();
     s.heal.clear();
     s.heal.resize(n, 0);
+    s.age.resize(n, 0);
     if w == 0 || n == 0 || !mask.contains(&1) {
+        s.age.fill(0);
         return 0;
     }
     let h = n / w;
@@ -119,8 +127,14 @@ pub(super) fn find(
         }
     }
     let ghost: Vec<bool> = energy.iter().map(|[c, g]| g > c).collect();
-    for (h, &l) in s.heal.iter_mut().zip(&s.labels) {
-        *h = u8::from(l != 0 && ghost[l as usize]);
+    let frames = test.frames.max(1);
+    for ((h, a), &l) in s.heal.iter_mut().zip(s.age.iter_mut()).zip(&s.labels) {
+        *a = if l != 0 && ghost[l as usize] {
+            a.saturating_add(1)
+        } else {
+            0
+        };
+        *h = u8::from(*a >= frames);
     }
     ghost.iter().skip(1).filter(|&&g| g).count()
 }

@@ -357,7 +357,7 @@ fn ramp_scene(x0: Option<u32>) -> RgbImage {
     o
 }
 
-fn selective_model(ghosts: bool) -> GaborBackground {
+fn selective_model(ghosts: Option<u32>) -> GaborBackground {
     let bank = GaborBank::new(GaborParams::default()).expect("bank");
     let update = Update::Selective {
         foreground_alpha: 0.0,
@@ -367,10 +367,9 @@ fn selective_model(ghosts: bool) -> GaborBackground {
         .expect("model")
         .with_update(update)
         .expect("update");
-    if ghosts {
-        m.with_ghost_removal(GhostTest { band_px: 4 })
-    } else {
-        m
+    match ghosts {
+        Some(frames) => m.with_ghost_removal(GhostTest { band_px: 4, frames }),
+        None => m,
     }
 }
 
@@ -378,7 +377,7 @@ fn selective_model(ghosts: bool) -> GaborBackground {
 fn a_person_who_left_the_first_frame_is_a_ghost_that_the_test_learns_away() {
     // causal start with the square in the first frame; then it is gone
     for ghosts in [false, true] {
-        let mut model = selective_model(ghosts);
+        let mut model = selective_model(ghosts.then_some(1));
         let mut mask = Mask::default();
         model
             .apply(&noisy(&ramp_scene(Some(6)), 0), &mut mask)
@@ -403,7 +402,7 @@ fn a_person_who_left_the_first_frame_is_a_ghost_that_the_test_learns_away() {
 
 #[test]
 fn a_person_who_arrives_is_not_a_ghost() {
-    let mut model = selective_model(true);
+    let mut model = selective_model(Some(1));
     let mut mask = Mask::default();
     for t in 0..3 {
         model
@@ -419,4 +418,25 @@ fn a_person_who_arrives_is_not_a_ghost() {
         assert!(s.foreground > 50, "frame {t}: {s:?}");
         assert_eq!(mask.get(26, 14), 1);
     }
+}
+
+#[test]
+fn a_ghost_is_learnt_after_the_frames_it_must_persist() {
+    // frames = 3: the ghost stays foreground for two frames, then is learnt on the third
+    let mut model = selective_model(Some(3));
+    let mut mask = Mask::default();
+    model
+        .apply(&noisy(&ramp_scene(Some(6)), 0), &mut mask)
+        .expect("first");
+    for t in 1..=3 {
+        let s = model
+            .apply(&noisy(&ramp_scene(None), t), &mut mask)
+            .expect("gone");
+        assert_eq!(s.ghosts, 1, "frame {t}: {s:?}");
+        assert_eq!(mask.get(10, 14), u8::from(t < 3), "frame {t}: {s:?}");
+    }
+    let s = model
+        .apply(&noisy(&ramp_scene(None), 4), &mut mask)
+        .expect("after");
+    assert_eq!((s.ghosts, s.foreground), (0, 0), "{s:?}");
 }

@@ -116,6 +116,7 @@ impl CameraChain {
         if p.ghost_removal {
             background = background.with_ghost_removal(GhostTest {
                 band_px: p.ghost_band_px,
+                frames: p.ghost_frames,
             });
         }
         if let Some(frames) = boot
