@@ -435,8 +435,16 @@ fn a_ghost_is_learnt_after_the_frames_it_must_persist() {
         assert_eq!(s.ghosts, 1, "frame {t}: {s:?}");
         assert_eq!(mask.get(10, 14), u8::from(t < 3), "frame {t}: {s:?}");
     }
-    let s = model
-        .apply(&noisy(&ramp_scene(None), 4), &mut mask)
-        .expect("after");
-    assert_eq!((s.ghosts, s.foreground), (0, 0), "{s:?}");
+    // learnt: the square's place stays background in the frames after (the MAD threshold
+    // still marks a few noise pixels anywhere, about 2 % of them in these frames)
+    for t in 4..=8 {
+        model
+            .apply(&noisy(&ramp_scene(None), t), &mut mask)
+            .expect("after");
+        let inside = (8..20)
+            .flat_map(|y| (6..14).map(move |x| (x, y)))
+            .filter(|&(x, y)| mask.get(x, y) == 1)
+            .count();
+        assert!(inside <= 5, "frame {t}: {inside} of 96");
+    }
 }

@@ -85,8 +85,21 @@ pub(crate) fn evaluate(s: &Scored, p: &Params, products: &mut Products) -> anyho
 /// Empty when the detections come from the log (no background).
 fn bootstrap_note(p: &Params) -> String {
     if p.detector != super::params::Detector::Templates {
-        String::new()
-    } else if p.bootstrap_frames == 0 {
+        return String::new();
+    }
+    let start = start_note(p);
+    if p.ghost_removal {
+        format!(
+            "{start} Ghost removal (our addition): a foreground region with more luminance edge along its contour in the background than in the frame is a ghost, learnt once a pixel has lain in ghosts for {} frames running (ghost_removal = false turns it off).",
+            p.ghost_frames
+        )
+    } else {
+        start
+    }
+}
+
+fn start_note(p: &Params) -> String {
+    if p.bootstrap_frames == 0 {
         "Background (template chain): started from the first frame alone and updated by eq. 2 (a causal start: no frame later than the one processed is used).".to_string()
     } else {
         format!(
