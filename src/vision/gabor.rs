@@ -648,25 +648,11 @@ impl GaborBackground {
             if ghost_count > 0 {
                 // the ghost's pixels become background: learnt at once, out of the mask
                 let heal = &self.ghost_scratch.heal;
-                for (b, m) in model.planes.iter_mut().zip(&self.current.planes) {
-                    for ((b, m), &g) in b.iter_mut().zip(m).zip(heal) {
-                        if g == 1 {
-                            *b = *m;
-                        }
-                    }
-                }
-                for (((b, m), k), &g) in self
-                    .luma_bg
+                ghosts::learn(model, &self.current, &mut self.luma_bg, &self.luma, heal);
+                mask.data
                     .iter_mut()
-                    .zip(&self.luma)
-                    .zip(mask.data.iter_mut())
                     .zip(heal)
-                {
-                    if g == 1 {
-                        *b = *m;
-                        *k = 0;
-                    }
-                }
+                    .for_each(|(k, &g)| *k &= 1 - g);
             }
         }
         if let Update::Selective {

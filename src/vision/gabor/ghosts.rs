@@ -25,7 +25,7 @@
 //! two part within a body width of walking); a person standing still from the first frame is
 //! in the background and stays missed until they move.
 
-use super::dilate;
+use super::{Features, dilate};
 use crate::vision::blobs::{self, Connectivity};
 
 /// The edge-matching ghost test.
@@ -137,4 +137,27 @@ pub(super) fn find(
         *h = u8::from(*a >= frames);
     }
     ghost.iter().skip(1).filter(|&&g| g).count()
+}
+
+/// Learn the ghost pixels (`heal` = 1) at once: the model's features and luminance there become
+/// the frame's.
+pub(super) fn learn(
+    model: &mut Features,
+    current: &Features,
+    luma_bg: &mut [f32],
+    luma: &[f32],
+    heal: &[u8],
+) {
+    for (b, m) in model.planes.iter_mut().zip(&current.planes) {
+        for ((b, m), &g) in b.iter_mut().zip(m).zip(heal) {
+            if g == 1 {
+                *b = *m;
+            }
+        }
+    }
+    for ((b, m), &g) in luma_bg.iter_mut().zip(luma).zip(heal) {
+        if g == 1 {
+            *b = *m;
+        }
+    }
 }
