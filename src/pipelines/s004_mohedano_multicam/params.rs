@@ -71,6 +71,8 @@ pub struct Params {
     pub ghost_band_px: u32,
     /// Frames running a pixel must lie in ghost regions before it is learnt.
     pub ghost_frames: u32,
+    /// The learnt ghost pixels grown by this many pixels (0: the region and its band only).
+    pub ghost_grow_px: u32,
     // §3 detection
     pub person_height_m: f64,
     pub template_scales: usize,
@@ -178,6 +180,7 @@ impl Default for Params {
             ghost_removal: true,
             ghost_band_px: 4,
             ghost_frames: 5,
+            ghost_grow_px: 0,
             person_height_m: 1.75,
             template_scales: 4,
             template_tilts: 4,
@@ -307,6 +310,12 @@ pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
         bad(
             "ghost_band_px",
             format!("{} is not in 1..=32 px", p.ghost_band_px),
+        );
+    }
+    if p.ghost_grow_px > 32 {
+        bad(
+            "ghost_grow_px",
+            format!("{} is not in 0..=32 px", p.ghost_grow_px),
         );
     }
     if p.ghost_frames == 0 || p.ghost_frames > 1000 {

@@ -36,6 +36,9 @@ pub struct GhostTest {
     /// A pixel is learnt once it has lain in a ghost region this many frames running
     /// (1: at the first verdict).
     pub frames: u32,
+    /// The learnt pixels grown by this much (pixels; 0: the region grown by the band only):
+    /// the features within the filter's radius of a ghost still see it through the kernel.
+    pub grow_px: u32,
 }
 
 /// Scratch of the test, reused between frames; `heal` holds the last frame's ghost pixels.
@@ -135,6 +138,16 @@ pub(super) fn find(
             0
         };
         *h = u8::from(*a >= frames);
+    }
+    if test.grow_px > 0 && s.heal.contains(&1) {
+        s.outside.clone_from(&s.heal);
+        dilate(
+            &s.outside,
+            w,
+            test.grow_px as usize,
+            &mut s.rows,
+            &mut s.heal,
+        );
     }
     ghost.iter().skip(1).filter(|&&g| g).count()
 }

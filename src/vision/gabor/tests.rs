@@ -368,7 +368,11 @@ fn selective_model(ghosts: Option<u32>) -> GaborBackground {
         .with_update(update)
         .expect("update");
     match ghosts {
-        Some(frames) => m.with_ghost_removal(GhostTest { band_px: 4, frames }),
+        Some(frames) => m.with_ghost_removal(GhostTest {
+            band_px: 4,
+            frames,
+            grow_px: 0,
+        }),
         None => m,
     }
 }

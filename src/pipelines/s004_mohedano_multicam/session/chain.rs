@@ -117,6 +117,7 @@ impl CameraChain {
             background = background.with_ghost_removal(GhostTest {
                 band_px: p.ghost_band_px,
                 frames: p.ghost_frames,
+                grow_px: p.ghost_grow_px,
             });
         }
         if let Some(frames) = boot
