@@ -170,12 +170,26 @@ mod tests {
             alpha: 0.0,
             foreground_alpha: 1.0,
             mad_k: f64::NAN,
+            ghost_band_px: 0,
+            ghost_frames: 0,
+            ghost_grow_px: 33,
             ..Params::default()
         };
         let named: Vec<String> = MulticamCylinders::validate(&p)
             .into_iter()
             .map(|(k, _)| k)
             .collect();
-        assert_eq!(named, ["cameras", "alpha", "foreground_alpha", "mad_k"]);
+        assert_eq!(
+            named,
+            [
+                "cameras",
+                "alpha",
+                "foreground_alpha",
+                "ghost_band_px",
+                "ghost_grow_px",
+                "ghost_frames",
+                "mad_k"
+            ]
+        );
     }
 }

@@ -251,6 +251,28 @@ fn validate_shapes(p: &Params, bad: &mut impl FnMut(&str, String)) {
     }
 }
 
+/// The ghost test's checks (issue 32).
+fn validate_ghosts(p: &Params, bad: &mut impl FnMut(&str, String)) {
+    if p.ghost_band_px == 0 || p.ghost_band_px > 32 {
+        bad(
+            "ghost_band_px",
+            format!("{} is not in 1..=32 px", p.ghost_band_px),
+        );
+    }
+    if p.ghost_grow_px > 32 {
+        bad(
+            "ghost_grow_px",
+            format!("{} is not in 0..=32 px", p.ghost_grow_px),
+        );
+    }
+    if p.ghost_frames == 0 || p.ghost_frames > 1000 {
+        bad(
+            "ghost_frames",
+            format!("{} is not in 1..=1000 frames", p.ghost_frames),
+        );
+    }
+}
+
 /// The checks of `occupancy`, `detector_noise` and `noise_associations` (issue 32).
 fn validate_noise(p: &Params, bad: &mut impl FnMut(&str, String)) {
     if let Err(e) = p.occupancy.validate() {
@@ -306,24 +328,7 @@ pub(crate) fn validate(p: &Params) -> Vec<Invalid> {
             format!("{} is not in [0, 1)", p.foreground_alpha),
         );
     }
-    if p.ghost_band_px == 0 || p.ghost_band_px > 32 {
-        bad(
-            "ghost_band_px",
-            format!("{} is not in 1..=32 px", p.ghost_band_px),
-        );
-    }
-    if p.ghost_grow_px > 32 {
-        bad(
-            "ghost_grow_px",
-            format!("{} is not in 0..=32 px", p.ghost_grow_px),
-        );
-    }
-    if p.ghost_frames == 0 || p.ghost_frames > 1000 {
-        bad(
-            "ghost_frames",
-            format!("{} is not in 1..=1000 frames", p.ghost_frames),
-        );
-    }
+    validate_ghosts(p, &mut bad);
     if !(p.mad_k >= 0.0 && p.mad_k.is_finite()) {
         bad("mad_k", format!("{} is not a finite number ≥ 0", p.mad_k));
     }
