@@ -180,7 +180,7 @@ impl Default for Params {
             ghost_removal: true,
             ghost_band_px: 4,
             ghost_frames: 5,
-            ghost_grow_px: 0,
+            ghost_grow_px: 6,
             person_height_m: 1.75,
             template_scales: 4,
             template_tilts: 4,

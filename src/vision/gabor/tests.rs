@@ -452,3 +452,44 @@ fn a_ghost_is_learnt_after_the_frames_it_must_persist() {
         assert!(inside <= 5, "frame {t}: {inside} of 96");
     }
 }
+
+#[test]
+fn the_learnt_ghost_pixels_are_the_region_grown_by_the_band_and_then_by_grow_px() {
+    // a ghost square: its edge in the background's luminance, none in the frame's
+    let (w, h) = (40usize, 30usize);
+    let inside = |x: usize, y: usize| (6..14).contains(&x) && (8..20).contains(&y);
+    let mask: Vec<u8> = (0..w * h).map(|i| u8::from(inside(i % w, i / w))).collect();
+    let cur = vec![0.5f32; w * h];
+    let bg: Vec<f32> = (0..w * h)
+        .map(|i| if inside(i % w, i / w) { 0.1 } else { 0.5 })
+        .collect();
+    // pixels within Chebyshev distance d of the square
+    let near = |d: usize| {
+        (0..w * h)
+            .filter(|&i| {
+                let (x, y) = (i % w, i / w);
+                x + d >= 6 && x < 14 + d && y + d >= 8 && y < 20 + d
+            })
+            .count()
+    };
+    for grow_px in [0u32, 3] {
+        let test = GhostTest {
+            band_px: 4,
+            frames: 1,
+            grow_px,
+        };
+        let mut s = ghosts::GhostScratch::default();
+        assert_eq!(ghosts::find(&mask, w, &cur, &bg, test, &mut s), 1);
+        let healed = s.heal.iter().filter(|&&v| v == 1).count();
+        assert_eq!(healed, near(4 + grow_px as usize), "grow_px {grow_px}");
+    }
+    // the same square in the frame and not in the background is no ghost
+    let mut s = ghosts::GhostScratch::default();
+    let test = GhostTest {
+        band_px: 4,
+        frames: 1,
+        grow_px: 3,
+    };
+    assert_eq!(ghosts::find(&mask, w, &bg, &cur, test, &mut s), 0);
+    assert!(!s.heal.contains(&1));
+}
