@@ -12,7 +12,9 @@
 //! with the same update; a region whose band has more gradient in the background than in the
 //! frame is a ghost. Once a pixel has lain in ghost regions for `frames` frames running (a
 //! ghost stands still; a wrong verdict on a walking person moves with them), it is cleared
-//! from the mask and the model there is replaced by the current frame. The comparison has no threshold of its own (more edge in the one image
+//! from the mask and the model there is replaced by the current frame — over the region grown
+//! by the band and then by `grow_px` (the features within the filter's radius of a ghost see
+//! it through the kernel). The comparison has no threshold of its own (more edge in the one image
 //! than in the other); the band follows from the Gabor envelope, which spreads a silhouette
 //! by about σ, so the edge lies within about 2σ of the mask's contour.
 //!
