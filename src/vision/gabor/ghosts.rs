@@ -46,8 +46,6 @@ pub struct GhostTest {
 /// Scratch of the test, reused between frames; `heal` holds the last frame's ghost pixels.
 #[derive(Debug, Default, Clone)]
 pub(super) struct GhostScratch {
-    grad_cur: Vec<f32>,
-    grad_bg: Vec<f32>,
     grown: Vec<u8>,
     outside: Vec<u8>,
     near_outside: Vec<u8>,
@@ -67,6 +65,22 @@ pub(super) fn luma(raw: &[u8], out: &mut Vec<f32>) {
     }));
 }
 
+/// The 3×3 Sobel gradient magnitude `√(Gx² + Gy²)` of a row-major plane (`w × h`, both > 0)
+/// at `(x, y)`, replicated borders.
+fn sobel_at(plane: &[f32], w: usize, h: usize, x: usize, y: usize) -> f32 {
+    let (x, y) = (x as isize, y as isize);
+    let at = |x: isize, y: isize| {
+        let x = x.clamp(0, w as isize - 1) as usize;
+        let y = y.clamp(0, h as isize - 1) as usize;
+        plane[y * w + x]
+    };
+    let gx = (at(x + 1, y - 1) + 2.0 * at(x + 1, y) + at(x + 1, y + 1))
+        - (at(x - 1, y - 1) + 2.0 * at(x - 1, y) + at(x - 1, y + 1));
+    let gy = (at(x - 1, y + 1) + 2.0 * at(x, y + 1) + at(x + 1, y + 1))
+        - (at(x - 1, y - 1) + 2.0 * at(x, y - 1) + at(x + 1, y - 1));
+    (gx * gx + gy * gy).sqrt()
+}
+
 /// The 3×3 Sobel gradient magnitude `√(Gx² + Gy²)` of a row-major plane, replicated borders.
 pub fn sobel_magnitude(plane: &[f32], w: usize, h: usize, out: &mut Vec<f32>) {
     out.clear();
@@ -74,18 +88,9 @@ pub fn sobel_magnitude(plane: &[f32], w: usize, h: usize, out: &mut Vec<f32>) {
     if w == 0 || h == 0 {
         return;
     }
-    let at = |x: isize, y: isize| {
-        let x = x.clamp(0, w as isize - 1) as usize;
-        let y = y.clamp(0, h as isize - 1) as usize;
-        plane[y * w + x]
-    };
-    for y in 0..h as isize {
-        for x in 0..w as isize {
-            let gx = (at(x + 1, y - 1) + 2.0 * at(x + 1, y) + at(x + 1, y + 1))
-                - (at(x - 1, y - 1) + 2.0 * at(x - 1, y) + at(x - 1, y + 1));
-            let gy = (at(x - 1, y + 1) + 2.0 * at(x, y + 1) + at(x + 1, y + 1))
-                - (at(x - 1, y - 1) + 2.0 * at(x, y - 1) + at(x + 1, y - 1));
-            out[y as usize * w + x as usize] = (gx * gx + gy * gy).sqrt();
+    for y in 0..h {
+        for x in 0..w {
+            out[y * w + x] = sobel_at(plane, w, h, x, y);
         }
     }
 }
@@ -111,8 +116,6 @@ pub(super) fn find(
     }
     let h = n / w;
     let b = test.band_px as usize;
-    sobel_magnitude(cur, w, h, &mut s.grad_cur);
-    sobel_magnitude(bg, w, h, &mut s.grad_bg);
     dilate(mask, w, b, &mut s.rows, &mut s.grown);
     s.outside.clear();
     s.outside.extend(mask.iter().map(|&m| u8::from(m == 0)));
@@ -122,13 +125,14 @@ pub(super) fn find(
     let Ok(regions) = blobs::label(&s.grown, w, h, Connectivity::Eight, 1, &mut s.labels) else {
         return 0;
     };
-    // band energy per region: [frame, background]
+    // band energy per region: [frame, background]; the gradient only where it is summed
     let mut energy = vec![[0.0f64; 2]; regions.len() + 1];
     for i in 0..n {
         let l = s.labels[i] as usize;
         if l != 0 && s.near_outside[i] == 1 {
-            energy[l][0] += f64::from(s.grad_cur[i]);
-            energy[l][1] += f64::from(s.grad_bg[i]);
+            let (x, y) = (i % w, i / w);
+            energy[l][0] += f64::from(sobel_at(cur, w, h, x, y));
+            energy[l][1] += f64::from(sobel_at(bg, w, h, x, y));
         }
     }
     let ghost: Vec<bool> = energy.iter().map(|[c, g]| g > c).collect();
