@@ -5,13 +5,14 @@
 //! share within 5°, pooled over the logs given.
 //!
 //! Usage: `cargo run --release --example doa_sweep -- LOG.mcap... [NAME:key=value,...]...`
-//! with keys `band_lo`, `band_hi`, `frame`, `hop`, `loud_share`, `phat_beta`, `onset`; the system's
+//! with keys `band_lo`, `band_hi`, `frame`, `hop`, `loud_share`, `phat_beta`, `onset`, `outer_share` and
+//! `weighting` (`phat_beta`, `diffuse_share`, `diffuse_ml`, `diffuse_phase`); the system's
 //! default settings are always the first row. `DUMP=NAME` prints that variant's every block.
 
 use std::collections::BTreeMap;
 
 use peopletrack::anchoring::system::SystemParams;
-use peopletrack::audio::gcc_phat::GccParams;
+use peopletrack::audio::gcc_phat::{GccParams, Weighting};
 use peopletrack::frames::{Skips, truth};
 use peopletrack::groundtruth::biron::UTTERANCES_TOPIC;
 use peopletrack::log::{SessionLog, TfBuffer};
@@ -25,6 +26,10 @@ fn variant(spec: &str, base: GccParams) -> Result<(String, GccParams), String> {
     let mut g = base;
     for pair in kv.split(',').filter(|s| !s.is_empty()) {
         let (k, v) = pair.split_once('=').ok_or(format!("{pair}: key=value"))?;
+        if k == "weighting" {
+            g.weighting = Weighting::from_name(v).ok_or(format!("{pair}: unknown weighting"))?;
+            continue;
+        }
         let x: f64 = v.parse().map_err(|e| format!("{pair}: {e}"))?;
         match k {
             "band_lo" => g.band_lo = x,
@@ -34,6 +39,7 @@ fn variant(spec: &str, base: GccParams) -> Result<(String, GccParams), String> {
             "loud_share" => g.loud_share = x,
             "phat_beta" => g.phat_beta = x,
             "onset" => g.onset = x,
+            "outer_share" => g.outer_share = x,
             _ => return Err(format!("unknown key {k}")),
         }
     }
@@ -64,6 +70,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let p = Params::default();
     let mut errs: BTreeMap<(usize, i64, i64), Vec<f64>> = BTreeMap::new();
+    // |est| − |true| cone (°): negative reads nearer broadside
+    let mut signed: BTreeMap<(usize, i64, i64), Vec<f64>> = BTreeMap::new();
     for path in &logs {
         let log = SessionLog::open(path)?;
         let mut skips = Skips::new();
@@ -94,19 +102,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 errs.entry((i, r.rt60_ms, r.snr_db))
                     .or_default()
                     .push(r.err_deg);
+                signed
+                    .entry((i, r.rt60_ms, r.snr_db))
+                    .or_default()
+                    .push(r.est_cone_deg.abs() - r.true_cone_deg.abs());
             }
         }
     }
-    println!("variant | rt60 ms | snr dB | blocks | median deg | p95 deg | within 5 deg");
+    println!(
+        "variant | rt60 ms | snr dB | blocks | median deg | p95 deg | within 5 deg | median |est|-|true| deg"
+    );
     for ((i, rt, snr), e) in &errs {
         let within = e.iter().filter(|x| **x <= 5.0).count() as f64 / e.len() as f64;
         println!(
-            "{} | {rt} | {snr} | {} | {:.2} | {:.1} | {:.3}",
+            "{} | {rt} | {snr} | {} | {:.2} | {:.1} | {:.3} | {:+.2}",
             variants[*i].0,
             e.len(),
             quantile(e, 0.5),
             quantile(e, 0.95),
-            within
+            within,
+            quantile(&signed[&(*i, *rt, *snr)], 0.5)
         );
     }
     Ok(())

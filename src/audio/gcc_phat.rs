@@ -50,6 +50,12 @@ use std::sync::Arc;
 use realfft::num_complex::Complex;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 
+use super::diffuse;
+
+/// The largest coherent-to-diffuse ratio [`Weighting::DiffuseMl`] weighs a bin by (a bin of
+/// coherence 1 would weigh infinitely).
+const MAX_CDR: f64 = 1e6;
+
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum GccError {
     #[error("GCC-PHAT settings: {0}")]
@@ -69,6 +75,47 @@ pub enum Refine {
     Grid,
     /// A parabola through the largest grid value and its neighbours.
     Parabolic,
+}
+
+/// How the block's summed cross-spectrum is weighted, bin by bin, before the inverse FFT.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Weighting {
+    /// `1/|G|^β` with [`GccParams::phat_beta`] (1: PHAT; rounds 2–7's estimator).
+    PhatBeta,
+    /// Diffuse-field aware ([`super::diffuse`]): each bin's coherence rid of the diffuse
+    /// field's `sin(kd)/(kd)`, its direct phase weighted by the direct share `CDR/(CDR + 1)`
+    /// (a Wiener gain on the phase). Every `Diffuse*` weight is also multiplied by the bin's
+    /// level `√(P₀P₁)^(1 − β)` ([`GccParams::phat_beta`]; β = 1: the weight alone).
+    DiffuseShare,
+    /// The direct phase weighted by `CDR` itself: Knapp & Carter's maximum-likelihood (SNR)
+    /// weight with the noise diffuse instead of incoherent between the microphones.
+    DiffuseMl,
+    /// The direct phase alone, every kept bin weight 1 (PHAT of the direct sound).
+    DiffusePhase,
+}
+
+impl Weighting {
+    /// The name used in pipeline files and the sweep.
+    pub fn name(self) -> &'static str {
+        match self {
+            Weighting::PhatBeta => "phat_beta",
+            Weighting::DiffuseShare => "diffuse_share",
+            Weighting::DiffuseMl => "diffuse_ml",
+            Weighting::DiffusePhase => "diffuse_phase",
+        }
+    }
+
+    /// The weighting called `name` ([`Weighting::name`]).
+    pub fn from_name(name: &str) -> Option<Weighting> {
+        [
+            Weighting::PhatBeta,
+            Weighting::DiffuseShare,
+            Weighting::DiffuseMl,
+            Weighting::DiffusePhase,
+        ]
+        .into_iter()
+        .find(|w| w.name() == name)
+    }
 }
 
 /// GCC-PHAT settings.
@@ -95,6 +142,14 @@ pub struct GccParams {
     /// `clamp(1 − ρ·P_{t−1}/P_t, 0, 1)` of its power against the previous frame's, the
     /// block's first frame only setting `P`; 0 turns it off (every frame weight 1).
     pub onset: f64,
+    /// The per-bin weighting of the summed cross-spectrum ([`Weighting`]).
+    pub weighting: Weighting,
+    /// Microphone spacing (m): the diffuse field's coherence for the `Diffuse*` weightings.
+    pub spacing_m: f64,
+    /// Which peak is the direct sound ([`outermost_peak`]): 1 takes the highest; below 1 the
+    /// local maximum farthest from zero lag, on the highest one's side, whose height is at
+    /// least this share of the highest (the floor's and the ceiling's images lie nearer zero).
+    pub outer_share: f64,
 }
 
 impl Default for GccParams {
@@ -115,6 +170,9 @@ impl Default for GccParams {
             loud_share: 1.0,
             phat_beta: 0.5,
             onset: 1.0,
+            weighting: Weighting::PhatBeta,
+            spacing_m: super::doa::BIRON_SPACING_M,
+            outer_share: 1.0,
         }
     }
 }
@@ -180,6 +238,18 @@ impl GccPhat {
             return Err(GccError::Settings(format!(
                 "phat_beta {} not in [0, 1]",
                 p.phat_beta
+            )));
+        }
+        if !(p.outer_share > 0.0 && p.outer_share <= 1.0) {
+            return Err(GccError::Settings(format!(
+                "outer_share {} not in (0, 1]",
+                p.outer_share
+            )));
+        }
+        if !(p.spacing_m > 0.0 && p.spacing_m.is_finite()) {
+            return Err(GccError::Settings(format!(
+                "spacing_m {} is not a positive length",
+                p.spacing_m
             )));
         }
         if !(p.sample_rate > 0.0 && p.band_lo >= 0.0 && p.band_lo < p.band_hi) {
@@ -253,46 +323,79 @@ impl GccPhat {
         } else {
             starts
         };
-        let mut sum = vec![Complex::new(0.0, 0.0); n / 2 + 1];
+        let bins = n / 2 + 1;
+        let mut sum = vec![Complex::new(0.0, 0.0); bins];
+        // the channels' (weighted) powers, for the diffuse weightings' coherence
+        let (mut pow0, mut pow1) = (vec![0.0; bins], vec![0.0; bins]);
         let rho = self.params.onset;
         // each frame's bin powers and the previous frame's, two buffers swapped per frame
-        let (mut power, mut before) = (vec![0.0; n / 2 + 1], vec![0.0; n / 2 + 1]);
+        let (mut power, mut before) = (vec![0.0; bins], vec![0.0; bins]);
         let mut frames = 0;
         for (i, &start) in keep.iter().enumerate() {
             self.fft_frame(&x0[start..start + n], true)?;
             self.fft_frame(&x1[start..start + n], false)?;
             let spectra = self.spec0.iter().zip(&self.spec1);
-            if rho == 0.0 {
-                for (s, (a, b)) in sum.iter_mut().zip(spectra) {
-                    *s += b * a.conj();
+            if rho > 0.0 {
+                for (p, (a, b)) in power.iter_mut().zip(spectra.clone()) {
+                    *p = 0.5 * (a.norm_sqr() + b.norm_sqr());
                 }
-                frames += 1;
-                continue;
             }
-            for (p, (a, b)) in power.iter_mut().zip(spectra.clone()) {
-                *p = 0.5 * (a.norm_sqr() + b.norm_sqr());
-            }
-            if i > 0 {
-                for (k, (s, (a, b))) in sum.iter_mut().zip(spectra).enumerate() {
-                    *s += b * a.conj() * onset_weight(power[k], before[k], rho);
+            if rho == 0.0 || i > 0 {
+                for (k, (a, b)) in spectra.enumerate() {
+                    let w = if rho == 0.0 {
+                        1.0
+                    } else {
+                        onset_weight(power[k], before[k], rho)
+                    };
+                    sum[k] += b * a.conj() * w;
+                    pow0[k] += a.norm_sqr() * w;
+                    pow1[k] += b.norm_sqr() * w;
                 }
                 frames += 1;
             }
             std::mem::swap(&mut power, &mut before);
         }
-        let bin_hz = self.params.sample_rate / n as f64;
+        self.weigh(&mut sum, &pow0, &pow1);
+        Ok((sum, frames))
+    }
+
+    /// The per-bin weighting ([`Weighting`]) of a summed cross-spectrum, in place; bins
+    /// outside the band and silent bins become zero.
+    fn weigh(&self, sum: &mut [Complex<f64>], pow0: &[f64], pow1: &[f64]) {
+        let p = &self.params;
+        let bin_hz = p.sample_rate / p.frame as f64;
         for (k, s) in sum.iter_mut().enumerate() {
             let f = k as f64 * bin_hz;
             let m = s.norm();
-            *s = if f < self.params.band_lo || f > self.params.band_hi || m <= 1e-300 {
-                Complex::new(0.0, 0.0)
-            } else if self.params.phat_beta == 1.0 {
-                *s / m
-            } else {
-                *s / m.powf(self.params.phat_beta)
+            if f < p.band_lo || f > p.band_hi || m <= 1e-300 {
+                *s = Complex::new(0.0, 0.0);
+                continue;
+            }
+            *s = match p.weighting {
+                Weighting::PhatBeta if p.phat_beta == 1.0 => *s / m,
+                Weighting::PhatBeta => *s / m.powf(p.phat_beta),
+                w => {
+                    let level = (pow0[k] * pow1[k]).sqrt().max(m);
+                    let gx = *s / level;
+                    let gn = diffuse::diffuse_coherence(f, p.spacing_m);
+                    let ratio = diffuse::cdr(gx, gn);
+                    let direct = diffuse::direct_phasor(gx, gn, ratio);
+                    let dm = direct.norm();
+                    if dm <= 1e-300 {
+                        Complex::new(0.0, 0.0)
+                    } else {
+                        // PHAT-β's kept magnitude: the bins' level^(1 − β)
+                        let unit = direct / dm * level.powf(1.0 - p.phat_beta);
+                        match w {
+                            Weighting::DiffuseShare if ratio.is_infinite() => unit,
+                            Weighting::DiffuseShare => unit * (ratio / (ratio + 1.0)),
+                            Weighting::DiffuseMl => unit * ratio.min(MAX_CDR),
+                            _ => unit,
+                        }
+                    }
+                }
             };
         }
-        Ok((sum, frames))
     }
 
     fn fft_frame(&mut self, x: &[f32], first: bool) -> Result<(), GccError> {
@@ -334,7 +437,7 @@ impl GccPhat {
             .map_err(|e| GccError::Fft(e.to_string()))?;
         // a pure delay sums to 2 per kept bin's weight (its mirror included), 1 at DC and
         // Nyquist; PHAT's weight is 1 per bin, PHAT-β's the bin's weighted magnitude
-        let phat = self.params.phat_beta == 1.0;
+        let phat = self.params.weighting == Weighting::PhatBeta && self.params.phat_beta == 1.0;
         let kept: f64 = cross
             .iter()
             .enumerate()
@@ -360,7 +463,14 @@ impl GccPhat {
     pub fn delay(&mut self, x0: &[f32], x1: &[f32], max_lag_s: f64) -> Result<Delay, GccError> {
         let (cross, frames) = self.cross_spectrum(x0, x1)?;
         let (first, step, r) = self.correlation(&cross, max_lag_s)?;
-        let (tau_s, peak) = peak(&r, first, step, max_lag_s, self.params.refine);
+        let (tau_s, peak) = outermost_peak(
+            &r,
+            first,
+            step,
+            max_lag_s,
+            self.params.refine,
+            self.params.outer_share,
+        );
         Ok(Delay {
             tau_s,
             peak,
@@ -383,16 +493,53 @@ pub fn onset_weight(now: f64, before: f64, rho: f64) -> f64 {
 
 /// The largest value of `r` (grid from `first`, step `step`) within `±max_lag`, and its lag.
 pub fn peak(r: &[f64], first: f64, step: f64, max_lag: f64, refine: Refine) -> (f64, f64) {
+    outermost_peak(r, first, step, max_lag, refine, 1.0)
+}
+
+/// The direct sound's peak of `r` within `±max_lag` and its lag: with `share` 1 the largest
+/// value ([`peak`]); below 1 the local maximum farthest from zero lag on the largest one's
+/// side whose height is at least `share` times the largest. A talker above the floor and
+/// below the ceiling has its floor and ceiling images at the same azimuth and a steeper
+/// elevation, so at a lag `cos ε_image / cos ε_direct` (< 1) times the direct one: nearer
+/// zero, on the same side. Where the images' peaks outgrow the direct sound's, the highest
+/// peak reads too small a cone; the outermost strong one does not (issue 33, round 8).
+pub fn outermost_peak(
+    r: &[f64],
+    first: f64,
+    step: f64,
+    max_lag: f64,
+    refine: Refine,
+    share: f64,
+) -> (f64, f64) {
     let lag = |i: usize| first + i as f64 * step;
+    let inside = |i: usize| lag(i).abs() <= max_lag + 1e-12;
     let mut best: Option<usize> = None;
     for (i, v) in r.iter().enumerate() {
-        if lag(i).abs() <= max_lag + 1e-12 && best.is_none_or(|b| *v > r[b]) {
+        if inside(i) && best.is_none_or(|b| *v > r[b]) {
             best = Some(i);
         }
     }
-    let Some(b) = best else {
+    let Some(mut b) = best else {
         return (0.0, 0.0);
     };
+    // at zero lag the highest peak has no side to look out on
+    if share < 1.0 && r[b] > 0.0 && lag(b).abs() > 0.5 * step {
+        let floor = share * r[b];
+        let side = lag(b).signum();
+        // scanning outwards from the highest peak, the last strong local maximum
+        let outwards: Box<dyn Iterator<Item = usize>> = if side > 0.0 {
+            Box::new(b + 1..r.len().saturating_sub(1))
+        } else {
+            Box::new((1..b).rev())
+        };
+        let mut outer = b;
+        for i in outwards {
+            if inside(i) && r[i] >= floor && r[i] > r[i - 1] && r[i] >= r[i + 1] {
+                outer = i;
+            }
+        }
+        b = outer;
+    }
     if refine == Refine::Grid || b == 0 || b + 1 >= r.len() {
         return (lag(b), r[b]);
     }

@@ -7,6 +7,8 @@
 //!   1976) over a block of frames, its correlogram, and the sub-sample peak.
 //! - [`doa`]: the cone angle asin(c·τ/d), its front/back mirror, the correction for a source
 //!   above or below the microphones, and the bound integer-lag quantisation alone gives.
+//! - [`diffuse`]: the diffuse field's coherence sin(kd)/(kd), a bin's coherent-to-diffuse
+//!   ratio and its direct sound's phase (the `Weighting::Diffuse*` GCC weightings).
 //! - [`activity`]: which blocks hold a directional sound (energy over a minimum-statistics
 //!   noise floor and the PHAT peak height).
 //! - [`wav`]: interleaved 16-bit samples as WAV bytes (`hound`).
@@ -14,6 +16,7 @@
 //! Not here: beam-forming, speech recognition, more than two microphones.
 
 pub mod activity;
+pub mod diffuse;
 pub mod doa;
 pub mod gcc_phat;
 pub mod wav;

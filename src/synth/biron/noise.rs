@@ -12,13 +12,9 @@ use rand::RngExt;
 use realfft::RealFftPlanner;
 use realfft::num_complex::Complex;
 
-use crate::audio::SPEED_OF_SOUND_M_S;
 
-/// Coherence of a spherically isotropic field at `f_hz` between microphones `spacing_m` apart.
-pub fn diffuse_coherence(f_hz: f64, spacing_m: f64) -> f64 {
-    let x = std::f64::consts::TAU * f_hz * spacing_m / SPEED_OF_SOUND_M_S;
-    if x.abs() < 1e-9 { 1.0 } else { x.sin() / x }
-}
+/// Coherence of a spherically isotropic field (one definition, shared with the estimator).
+pub use crate::audio::diffuse::diffuse_coherence;
 
 /// `n` samples of diffuse noise at two microphones `spacing_m` apart, unit mean power per
 /// channel, deterministic in `rng`.
