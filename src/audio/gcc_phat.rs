@@ -43,6 +43,13 @@
 //! selection ([`GccParams::loud_share`]) stays a setting; the onset weight then compares each
 //! kept frame with the one kept before it.
 //!
+//! Round 8 (issue 33) added the diffuse-field-aware weightings ([`Weighting`],
+//! [`super::diffuse`]) and the outermost strong peak ([`GccParams::outer_share`]); swept on the
+//! development split with quick (131 blocks per cell) neither met the declared rule at the
+//! nominal cell (best 2.92° against 2.96°), so both stay settings, off by default. The
+//! diffuse ML weighting with β 0.5 is far better without reverberation (anechoic 10 dB 0.91° →
+//! 0.21°) and the flat one at RT60 0.3 s / 30 dB (1.59° → 0.80°): docs/s003_biron_anchoring.md.
+//!
 //! FFTs by `realfft`/`rustfft`. Not here: frame-wise tracking, several sources per block.
 
 use std::sync::Arc;
