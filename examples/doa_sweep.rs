@@ -5,7 +5,7 @@
 //! share within 5°, pooled over the logs given.
 //!
 //! Usage: `cargo run --release --example doa_sweep -- LOG.mcap... [NAME:key=value,...]...`
-//! with keys `band_lo`, `band_hi`, `frame`, `hop`, `loud_share`, `phat_beta`, `onset`, `outer_share`, `image_fit` (0/1) and
+//! with keys `band_lo`, `band_hi`, `frame`, `hop`, `loud_share`, `phat_beta`, `onset`, `outer_share` and
 //! `weighting` (`phat_beta`, `diffuse_share`, `diffuse_ml`, `diffuse_phase`); the system's
 //! default settings are always the first row. `DUMP=NAME` prints that variant's every block.
 
@@ -40,7 +40,6 @@ fn variant(spec: &str, base: GccParams) -> Result<(String, GccParams), String> {
             "phat_beta" => g.phat_beta = x,
             "onset" => g.onset = x,
             "outer_share" => g.outer_share = x,
-            "image_fit" => g.image_fit = x != 0.0,
             _ => return Err(format!("unknown key {k}")),
         }
     }

@@ -157,9 +157,6 @@ pub struct GccParams {
     /// local maximum farthest from zero lag, on the highest one's side, whose height is at
     /// least this share of the highest (the floor's and the ceiling's images lie nearer zero).
     pub outer_share: f64,
-    /// Fit the direct sound and its floor/ceiling image together ([`super::images`]) instead
-    /// of reading the peak (`outer_share` and `refine` then unused).
-    pub image_fit: bool,
 }
 
 impl Default for GccParams {
@@ -183,7 +180,6 @@ impl Default for GccParams {
             weighting: Weighting::PhatBeta,
             spacing_m: super::doa::BIRON_SPACING_M,
             outer_share: 1.0,
-            image_fit: false,
         }
     }
 }
@@ -474,22 +470,6 @@ impl GccPhat {
     pub fn delay(&mut self, x0: &[f32], x1: &[f32], max_lag_s: f64) -> Result<Delay, GccError> {
         let (cross, frames) = self.cross_spectrum(x0, x1)?;
         let (first, step, r) = self.correlation(&cross, max_lag_s)?;
-        if self.params.image_fit {
-            // the lobe of these weights over every difference of two lags on the grid
-            let mags: Vec<Complex<f64>> =
-                cross.iter().map(|c| Complex::new(c.norm(), 0.0)).collect();
-            let (h_first, _, h) = self.correlation(&mags, 2.0 * max_lag_s)?;
-            let zero = (-first / step).round() as usize;
-            let h_zero = (-h_first / step).round() as usize;
-            if let Some(d) = super::images::fit(&r, zero, &h, h_zero, &super::images::IMAGE_RATIOS)
-            {
-                return Ok(Delay {
-                    tau_s: first + d as f64 * step,
-                    peak: r[d],
-                    frames,
-                });
-            }
-        }
         let (tau_s, peak) = outermost_peak(
             &r,
             first,

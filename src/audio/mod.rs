@@ -9,7 +9,6 @@
 //!   above or below the microphones, and the bound integer-lag quantisation alone gives.
 //! - [`diffuse`]: the diffuse field's coherence sin(kd)/(kd), a bin's coherent-to-diffuse
 //!   ratio and its direct sound's phase (the `Weighting::Diffuse*` GCC weightings).
-//! - [`images`]: the direct sound and its floor/ceiling image fitted together on a GCC curve.
 //! - [`activity`]: which blocks hold a directional sound (energy over a minimum-statistics
 //!   noise floor and the PHAT peak height).
 //! - [`wav`]: interleaved 16-bit samples as WAV bytes (`hound`).
@@ -20,7 +19,6 @@ pub mod activity;
 pub mod diffuse;
 pub mod doa;
 pub mod gcc_phat;
-pub mod images;
 pub mod wav;
 
 /// Speed of sound in air at 20 °C (m/s).
