@@ -80,7 +80,10 @@ mod tests {
         ] {
             let gx = mixed(ratio, alpha, gn);
             let got = cdr(gx, gn);
-            assert!((got - ratio).abs() < 1e-9 * ratio.max(1.0), "{ratio}: {got}");
+            assert!(
+                (got - ratio).abs() < 1e-9 * ratio.max(1.0),
+                "{ratio}: {got}"
+            );
             let d = direct_phasor(gx, gn, got);
             assert!((d.norm() - ratio).abs() < 1e-9, "{}", d.norm());
             assert!((d.arg() - alpha).abs() < 1e-9, "{alpha}: {}", d.arg());

@@ -307,7 +307,10 @@ fn every_weighting_finds_a_source_in_diffuse_noise_of_equal_power() {
             .collect();
         let p_src = lp.iter().map(|v| v * v).sum::<f64>() / lp.len() as f64;
         let s0: Vec<f32> = lp.iter().map(|&v| (v / p_src.sqrt()) as f32).collect();
-        let s1 = delayed(&lp.iter().map(|v| v / p_src.sqrt()).collect::<Vec<_>>(), tau * FS);
+        let s1 = delayed(
+            &lp.iter().map(|v| v / p_src.sqrt()).collect::<Vec<_>>(),
+            tau * FS,
+        );
         let mut r = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let [n0, n1] =
             crate::synth::biron::noise::diffuse_pair(16_384, FS, BIRON_SPACING_M, &mut r);
@@ -359,7 +362,10 @@ fn the_outermost_strong_peak_on_the_highest_ones_side_is_taken() {
         .collect();
     let lag = |share| outermost_peak(&r, first, step, max, Refine::Parabolic, share).0 * FS;
     assert!((lag(1.0) - 6.0).abs() < 0.01, "highest: {}", lag(1.0));
-    assert!((lag(0.9) - 6.0).abs() < 0.01, "9 is below 0.9 of the highest");
+    assert!(
+        (lag(0.9) - 6.0).abs() < 0.01,
+        "9 is below 0.9 of the highest"
+    );
     assert!((lag(0.7) - 9.0).abs() < 0.01, "outermost: {}", lag(0.7));
     // mirrored: the same on the negative side
     let m: Vec<f64> = r.iter().rev().copied().collect();

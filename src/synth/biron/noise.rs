@@ -12,7 +12,6 @@ use rand::RngExt;
 use realfft::RealFftPlanner;
 use realfft::num_complex::Complex;
 
-
 /// Coherence of a spherically isotropic field (one definition, shared with the estimator).
 pub use crate::audio::diffuse::diffuse_coherence;
 
