@@ -102,7 +102,7 @@ pub enum Weighting {
 }
 
 impl Weighting {
-    /// The name used in pipeline files and the sweep.
+    /// The name used by `examples/doa_sweep.rs` and `examples/doa_curve.rs`.
     pub fn name(self) -> &'static str {
         match self {
             Weighting::PhatBeta => "phat_beta",
@@ -332,7 +332,8 @@ impl GccPhat {
         };
         let bins = n / 2 + 1;
         let mut sum = vec![Complex::new(0.0, 0.0); bins];
-        // the channels' (weighted) powers, for the diffuse weightings' coherence
+        // the channels' (weighted) powers, for the diffuse weightings' coherence only
+        let coherence = self.params.weighting != Weighting::PhatBeta;
         let (mut pow0, mut pow1) = (vec![0.0; bins], vec![0.0; bins]);
         let rho = self.params.onset;
         // each frame's bin powers and the previous frame's, two buffers swapped per frame
@@ -355,8 +356,10 @@ impl GccPhat {
                         onset_weight(power[k], before[k], rho)
                     };
                     sum[k] += b * a.conj() * w;
-                    pow0[k] += a.norm_sqr() * w;
-                    pow1[k] += b.norm_sqr() * w;
+                    if coherence {
+                        pow0[k] += a.norm_sqr() * w;
+                        pow1[k] += b.norm_sqr() * w;
+                    }
                 }
                 frames += 1;
             }

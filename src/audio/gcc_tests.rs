@@ -38,6 +38,19 @@ fn delayed_noise(n: usize, delay: f64, seed: u64) -> (Vec<f32>, Vec<f32>) {
     (x0, delayed(&x, delay))
 }
 
+/// White noise of `n` samples through a one-pole low-pass (energy falling with frequency,
+/// like a voice).
+fn low_passed(n: usize, seed: u64) -> Vec<f32> {
+    let (w0, _) = delayed_noise(n, 0.0, seed);
+    let mut y = 0.0f32;
+    w0.iter()
+        .map(|v| {
+            y = 0.9 * y + v;
+            y
+        })
+        .collect()
+}
+
 fn block(x: &[f32]) -> &[f32] {
     &x[4096..4096 + 8000] // 0.5 s away from the circular wrap
 }
@@ -65,13 +78,7 @@ fn pure_fractional_delays_give_the_angle_within_a_tenth_of_a_degree() {
 fn every_phat_exponent_finds_a_pure_delay_of_coloured_noise_with_peak_one() {
     // noise through a one-pole low-pass (energy falling with frequency, like a voice), then
     // delayed exactly: the cross-spectrum's phase is the delay's whatever the weighting
-    let (w0, _) = delayed_noise(16_384, 0.0, 21);
-    let mut lp = Vec::with_capacity(w0.len());
-    let mut y = 0.0f32;
-    for v in &w0 {
-        y = 0.9 * y + v;
-        lp.push(y);
-    }
+    let lp = low_passed(16_384, 21);
     let delay = 2.7;
     let x1 = delayed(&lp.iter().map(|&v| f64::from(v)).collect::<Vec<_>>(), delay);
     for beta in [0.0, 0.5, 0.7, 1.0] {
@@ -296,14 +303,9 @@ fn every_weighting_finds_a_source_in_diffuse_noise_of_equal_power() {
     ];
     let mut total = [0.0; 4];
     for seed in 0..8u64 {
-        let (w0, _) = delayed_noise(16_384, 0.0, 60 + seed);
-        let mut y = 0.0f32;
-        let lp: Vec<f64> = w0
-            .iter()
-            .map(|v| {
-                y = 0.9 * y + v;
-                f64::from(y)
-            })
+        let lp: Vec<f64> = low_passed(16_384, 60 + seed)
+            .into_iter()
+            .map(f64::from)
             .collect();
         let p_src = lp.iter().map(|v| v * v).sum::<f64>() / lp.len() as f64;
         let s0: Vec<f32> = lp.iter().map(|&v| (v / p_src.sqrt()) as f32).collect();
