@@ -186,7 +186,7 @@ impl Default for Params {
             template_tilts: 4,
             template_threshold: 0.7,
             template_fill: 0.5,
-            template_width: 1.0,
+            template_width: 1.5,
             template_grow_px: 2,
             templates_by_position: true,
             template_stride_px: 2,
