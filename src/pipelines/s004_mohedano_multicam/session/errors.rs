@@ -497,9 +497,11 @@ mod tests {
     fn misses_and_false_detections_get_the_cause_of_the_stage_that_made_them() {
         let view = view();
         let (mask, gt, s, head) = scene(&view);
-        // the mask holds the silhouette undilated: so does the person's own template
+        // the mask holds the silhouette undilated and at the profile's width: so does the
+        // person's own template
         let p = Params {
             template_grow_px: 0,
+            template_width: 1.0,
             ..Params::default()
         };
         let det = DetectorParams {
